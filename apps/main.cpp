@@ -1,0 +1,3 @@
+#include "core/scene.h"
+#include <iostream>
+int main(){ std::cout << surge::sceneKeysMarkdown(); }

@@ -1,0 +1,86 @@
+#include "core/files.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "core/errors.h"
+
+namespace surge {
+
+void writeFileAtomically(const fs::path& path, const std::function<void(std::ostream&)>& write) {
+  if (path.has_parent_path()) fs::create_directories(path.parent_path());
+  fs::path temporary = path;
+  temporary += ".tmp" + std::to_string(::getpid());
+  try {
+    {
+      std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+      if (!out) throw RunError("cannot write " + temporary.string());
+      write(out);
+      out.flush();
+      if (!out) throw RunError("error while writing " + temporary.string());
+    }
+    fs::rename(temporary, path);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+    throw;
+  }
+}
+
+fs::path framePath(const fs::path& dir, const std::string& sub, int frame, const std::string& ext) {
+  char name[64];
+  std::snprintf(name, sizeof name, "frame_%05d.%s", frame, ext.c_str());
+  return dir / sub / name;
+}
+
+std::vector<int> listFrames(const fs::path& dir, const std::string& sub, const std::string& ext) {
+  std::vector<int> frames;
+  const fs::path folder = dir / sub;
+  std::error_code error;
+  if (!fs::is_directory(folder, error)) return frames;
+  const std::string suffix = "." + ext;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() != 11 + suffix.size() || name.rfind("frame_", 0) != 0) continue;
+    if (name.compare(11, std::string::npos, suffix) != 0) continue;
+    const std::string digits = name.substr(6, 5);
+    if (!std::all_of(digits.begin(), digits.end(), ::isdigit)) continue;
+    frames.push_back(std::stoi(digits));
+  }
+  std::sort(frames.begin(), frames.end());
+  return frames;
+}
+
+FrameRange FrameRange::parse(const std::string& text) {
+  FrameRange range;
+  const auto colon = text.find(':');
+  auto number = [&](const std::string& part, int fallback) {
+    if (part.empty()) return fallback;
+    if (!std::all_of(part.begin(), part.end(), ::isdigit) || part.size() > 9)
+      throw InputError("--frames", "expected A:B with frame numbers, got '" + text + "'");
+    return std::stoi(part);
+  };
+  if (colon == std::string::npos) {
+    range.first = range.last = number(text, 0);
+    if (text.empty()) throw InputError("--frames", "expected A:B, got an empty value");
+  } else {
+    range.first = number(text.substr(0, colon), 0);
+    range.last = number(text.substr(colon + 1), range.last);
+  }
+  if (range.last < range.first) throw InputError("--frames", "the range '" + text + "' is empty");
+  return range;
+}
+
+std::string readTextFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string(), "cannot be read");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+}  // namespace surge

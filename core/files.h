@@ -1,0 +1,35 @@
+// File helpers shared by every stage: atomic writes, frame file names, frame listing and ranges.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace surge {
+
+namespace fs = std::filesystem;
+
+// Writes through a temporary file beside `path` and renames it into place, so that a reader sees either the
+// old file or the whole new one. On any exception the temporary file is removed and the exception rethrown.
+void writeFileAtomically(const fs::path& path, const std::function<void(std::ostream&)>& write);
+
+// dir/sub/frame_NNNNN.ext (five digits).
+fs::path framePath(const fs::path& dir, const std::string& sub, int frame, const std::string& ext);
+
+// The frame numbers of the dir/sub/frame_NNNNN.ext files present, sorted.
+std::vector<int> listFrames(const fs::path& dir, const std::string& sub, const std::string& ext);
+
+// An inclusive range of frames, from a --frames "A:B" flag ("A:" and ":B" leave an end open).
+struct FrameRange {
+  int first = 0;
+  int last = 1 << 30;
+  bool contains(int frame) const { return frame >= first && frame <= last; }
+  static FrameRange parse(const std::string& text);  // throws InputError naming --frames
+};
+
+// Reads a whole text file; throws InputError naming the file if it cannot be read.
+std::string readTextFile(const fs::path& path);
+
+}  // namespace surge

@@ -1,0 +1,44 @@
+// Binary little-endian PLY, the format of Surge's particle frames and surface meshes.
+// Particle frames (DESIGN.md): one `vertex` element with float x y z vx vy vz and uint id; a frame holds
+// everything needed to continue a simulation from it. Meshes: vertex x y z nx ny nz and a `face` element with a
+// `vertex_indices` list, as Blender and Houdini read them. Writes are atomic (see writeFileAtomically).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/files.h"
+
+namespace surge {
+
+struct ParticleFrame {
+  int dimensions = 3;
+  std::vector<Eigen::Vector3f> position;
+  std::vector<Eigen::Vector3f> velocity;
+  std::vector<uint32_t> id;  // stable particle identity, kept across reordering
+
+  size_t size() const { return position.size(); }
+  void resize(size_t n) {
+    position.resize(n);
+    velocity.resize(n);
+    id.resize(n);
+  }
+};
+
+struct TriangleMesh {
+  std::vector<Eigen::Vector3f> positions;
+  std::vector<Eigen::Vector3f> normals;  // one per vertex, or empty
+  std::vector<std::array<uint32_t, 3>> triangles;
+};
+
+void writeParticlePly(const fs::path& path, const ParticleFrame& frame);
+// Throws InputError naming the file and the header line or property at fault.
+ParticleFrame readParticlePly(const fs::path& path);
+
+void writeMeshPly(const fs::path& path, const TriangleMesh& mesh);
+TriangleMesh readMeshPly(const fs::path& path);
+
+}  // namespace surge

@@ -1,0 +1,452 @@
+#include "core/scene.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "core/errors.h"
+#include "core/scene_fields.h"
+
+namespace surge {
+namespace {
+
+using nlohmann::json;
+
+std::string describe(const json& value) {
+  std::string text = value.dump();
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  return text;
+}
+
+std::string formatNumber(double value) {
+  std::ostringstream out;
+  out << std::setprecision(10) << value;
+  return out.str();
+}
+
+std::string rangeText(const FieldInfo& info) {
+  std::string text;
+  if (std::isfinite(info.min)) text += (info.minExclusive ? "> " : ">= ") + formatNumber(info.min);
+  if (std::isfinite(info.max) && info.max < 1e299) text += (text.empty() ? "<= " : ", <= ") + formatNumber(info.max);
+  return text;
+}
+
+// Reads JSON into the scene, checking types, ranges, required and unknown keys.
+class JsonReader : public SceneVisitor {
+ public:
+  JsonReader(const json& root, std::string where, Scene& scene, const std::set<std::string>& overridden)
+      : where_(std::move(where)), scene_(scene), overridden_(overridden) {
+    if (!root.is_object()) throw InputError(where_, "the top level must be a JSON object");
+    stack_.push_back(Level{&root, "", {}});
+  }
+
+  void finish() { checkUnknown(stack_.back()); }
+
+  void text(const char* key, std::string& value, const FieldInfo& info) override {
+    if (const json* j = find(key, info)) {
+      if (!j->is_string()) fail(key, "expected a string, got " + describe(*j));
+      value = j->get<std::string>();
+      if (info.required && value.empty()) fail(key, "must not be empty");
+    }
+  }
+
+  void choice(const char* key, std::string& value, const std::vector<std::string>& options,
+              const FieldInfo& info) override {
+    if (const json* j = find(key, info)) {
+      if (!j->is_string()) fail(key, "expected a string, got " + describe(*j));
+      value = j->get<std::string>();
+      for (const std::string& option : options)
+        if (value == option) return;
+      std::string list;
+      for (const std::string& option : options) list += (list.empty() ? "" : ", ") + option;
+      fail(key, "'" + value + "' is not one of: " + list);
+    }
+  }
+
+  void integer(const char* key, int& value, const FieldInfo& info) override {
+    if (const json* j = find(key, info)) {
+      if (!j->is_number_integer()) fail(key, "expected an integer, got " + describe(*j));
+      const long long v = j->get<long long>();
+      checkRange(key, double(v), info);
+      value = static_cast<int>(v);
+    }
+  }
+
+  void real(const char* key, double& value, const FieldInfo& info) override {
+    if (const json* j = find(key, info)) {
+      if (!j->is_number()) fail(key, "expected a number, got " + describe(*j));
+      const double v = j->get<double>();
+      checkRange(key, v, info);
+      value = v;
+    }
+  }
+
+  void vector(const char* key, Eigen::Vector3d& value, const FieldInfo& info, bool always3) override {
+    if (const json* j = find(key, info)) {
+      const size_t n = always3 ? 3 : static_cast<size_t>(scene_.dimensions);
+      if (!j->is_array() || j->size() != n)
+        fail(key, "expected an array of " + std::to_string(n) + " numbers, got " + describe(*j));
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      for (size_t k = 0; k < n; ++k) {
+        if (!(*j)[k].is_number()) fail(key, "expected numbers, got " + describe(*j));
+        v[k] = (*j)[k].get<double>();
+        if (!std::isfinite(v[k])) fail(key, "must be finite");
+        checkRange(key, v[k], info);
+      }
+      value = v;
+    }
+  }
+
+  void group(const char* key, const FieldInfo& info, const std::function<void()>& body) override {
+    const json* j = find(key, info);
+    if (!j) return;
+    if (!j->is_object()) fail(key, "expected an object, got " + describe(*j));
+    stack_.push_back(Level{j, path(key), {}});
+    body();
+    checkUnknown(stack_.back());
+    stack_.pop_back();
+  }
+
+  void list(const char* key, const FieldInfo& info, const std::function<size_t()>&,
+            const std::function<void(size_t)>& resize, const std::function<void(size_t)>& visitItem) override {
+    const json* j = find(key, info);
+    if (!j) return;
+    if (!j->is_array()) fail(key, "expected an array, got " + describe(*j));
+    if (info.required && j->empty()) fail(key, "must not be empty");
+    resize(j->size());
+    for (size_t i = 0; i < j->size(); ++i) {
+      const std::string itemPath = path(key) + "[" + std::to_string(i) + "]";
+      if (!(*j)[i].is_object()) throw error(itemPath, "expected an object, got " + describe((*j)[i]));
+      stack_.push_back(Level{&(*j)[i], itemPath, {}});
+      visitItem(i);
+      checkUnknown(stack_.back());
+      stack_.pop_back();
+    }
+  }
+
+ private:
+  struct Level {
+    const json* object;
+    std::string path;
+    std::set<std::string> seen;
+  };
+
+  std::string path(const std::string& key) const {
+    const std::string& prefix = stack_.back().path;
+    return prefix.empty() ? key : prefix + "." + key;
+  }
+
+  InputError error(const std::string& fullPath, const std::string& message) const {
+    return InputError(overridden_.count(fullPath) ? "--set" : where_, fullPath, message);
+  }
+
+  [[noreturn]] void fail(const char* key, const std::string& message) const { throw error(path(key), message); }
+
+  const json* find(const char* key, const FieldInfo& info) {
+    Level& level = stack_.back();
+    level.seen.insert(key);
+    auto it = level.object->find(key);
+    if (it == level.object->end()) {
+      if (info.required) fail(key, "missing required key");
+      return nullptr;
+    }
+    return &*it;
+  }
+
+  void checkRange(const char* key, double v, const FieldInfo& info) const {
+    if (!std::isfinite(v)) fail(key, "must be finite");
+    if (v < info.min || (info.minExclusive && v <= info.min) || v > info.max)
+      fail(key, formatNumber(v) + " is out of range (" + rangeText(info) + ")");
+  }
+
+  void checkUnknown(const Level& level) const {
+    for (auto it = level.object->begin(); it != level.object->end(); ++it)
+      if (!level.seen.count(it.key())) {
+        const std::string full = level.path.empty() ? it.key() : level.path + "." + it.key();
+        throw error(full, "unknown key");
+      }
+  }
+
+  std::string where_;
+  Scene& scene_;
+  const std::set<std::string>& overridden_;
+  std::vector<Level> stack_;
+};
+
+// Writes every key of the scene as JSON.
+class JsonWriter : public SceneVisitor {
+ public:
+  explicit JsonWriter(const Scene& scene) : dimensions_(scene.dimensions) { stack_.push_back(&root_); }
+  const json& root() const { return root_; }
+
+  void text(const char* key, std::string& value, const FieldInfo&) override { (*stack_.back())[key] = value; }
+  void choice(const char* key, std::string& value, const std::vector<std::string>&, const FieldInfo&) override {
+    (*stack_.back())[key] = value;
+  }
+  void integer(const char* key, int& value, const FieldInfo&) override { (*stack_.back())[key] = value; }
+  void real(const char* key, double& value, const FieldInfo&) override { (*stack_.back())[key] = value; }
+  void vector(const char* key, Eigen::Vector3d& value, const FieldInfo&, bool always3) override {
+    json array = json::array();
+    for (int k = 0; k < (always3 ? 3 : dimensions_); ++k) array.push_back(value[k]);
+    (*stack_.back())[key] = array;
+  }
+  void group(const char* key, const FieldInfo&, const std::function<void()>& body) override {
+    json& child = (*stack_.back())[key] = json::object();
+    stack_.push_back(&child);
+    body();
+    stack_.pop_back();
+  }
+  void list(const char* key, const FieldInfo&, const std::function<size_t()>& size,
+            const std::function<void(size_t)>&, const std::function<void(size_t)>& visitItem) override {
+    json& array = (*stack_.back())[key] = json::array();
+    for (size_t i = 0; i < size(); ++i) {
+      array.push_back(json::object());
+      stack_.push_back(&array.back());
+      visitItem(i);
+      stack_.pop_back();
+    }
+  }
+
+ private:
+  int dimensions_;
+  json root_ = json::object();
+  std::vector<json*> stack_;
+};
+
+// Lists every key as a markdown table row.
+class KeyTable : public SceneVisitor {
+ public:
+  std::string rows;
+
+  void text(const char* key, std::string& value, const FieldInfo& info) override {
+    row(key, "string", value.empty() ? "" : "\"" + value + "\"", info);
+  }
+  void choice(const char* key, std::string& value, const std::vector<std::string>& options,
+              const FieldInfo& info) override {
+    std::string list;
+    for (const std::string& option : options) list += (list.empty() ? "" : ", ") + ("`" + option + "`");
+    row(key, "string", "\"" + value + "\"", info, "one of " + list);
+  }
+  void integer(const char* key, int& value, const FieldInfo& info) override {
+    row(key, "integer", std::to_string(value), info);
+  }
+  void real(const char* key, double& value, const FieldInfo& info) override {
+    row(key, "number", formatNumber(value), info);
+  }
+  void vector(const char* key, Eigen::Vector3d& value, const FieldInfo& info, bool always3) override {
+    std::string text = "[" + formatNumber(value[0]) + ", " + formatNumber(value[1]) + ", " + formatNumber(value[2]) + "]";
+    row(key, always3 ? "3-vector" : "vector", info.required ? "" : text, info);
+  }
+  void group(const char* key, const FieldInfo& info, const std::function<void()>& body) override {
+    row(key, "object", "", info);
+    prefix_.push_back(prefixed(key) + ".");
+    body();
+    prefix_.pop_back();
+  }
+  void list(const char* key, const FieldInfo& info, const std::function<size_t()>&,
+            const std::function<void(size_t)>& resize, const std::function<void(size_t)>& visitItem) override {
+    row(key, "array of objects", "", info);
+    resize(1);
+    prefix_.push_back(prefixed(key) + "[i].");
+    visitItem(0);
+    prefix_.pop_back();
+  }
+
+ private:
+  std::string prefixed(const char* key) const { return (prefix_.empty() ? "" : prefix_.back()) + key; }
+  void row(const char* key, const std::string& type, const std::string& value, const FieldInfo& info,
+           std::string allowed = "") {
+    if (allowed.empty()) allowed = rangeText(info);
+    std::string units = *info.units ? std::string(" (") + info.units + ")" : "";
+    rows += "| `" + prefixed(key) + "` | " + type + " | " + (info.required ? "required" : value) + " | " +
+            allowed + " | " + info.description + units + " |\n";
+  }
+  std::vector<std::string> prefix_;
+};
+
+// Splits "solver.iterations" or "fluids[0].box.min" / "fluids.0.box.min" into JSON pointer parts.
+std::vector<std::string> splitKeyPath(const std::string& path) {
+  std::vector<std::string> parts;
+  std::string current;
+  for (char c : path) {
+    if (c == '.' || c == '[') {
+      if (!current.empty()) parts.push_back(current);
+      current.clear();
+    } else if (c != ']') {
+      current += c;
+    }
+  }
+  if (!current.empty()) parts.push_back(current);
+  return parts;
+}
+
+std::string normalisedPath(const std::vector<std::string>& parts) {
+  std::string path;
+  for (const std::string& part : parts) {
+    const bool index = !part.empty() && std::all_of(part.begin(), part.end(), ::isdigit);
+    path += index ? "[" + part + "]" : (path.empty() ? "" : ".") + part;
+  }
+  return path;
+}
+
+void applyOverride(json& root, const std::string& assignment, std::set<std::string>& overridden) {
+  const auto equals = assignment.find('=');
+  if (equals == std::string::npos || equals == 0)
+    throw InputError("--set", assignment, "expected key.path=value");
+  const std::string keyPath = assignment.substr(0, equals);
+  const std::string valueText = assignment.substr(equals + 1);
+  const std::vector<std::string> parts = splitKeyPath(keyPath);
+  if (parts.empty()) throw InputError("--set", assignment, "expected key.path=value");
+  json value = json::parse(valueText, nullptr, false);
+  if (value.is_discarded()) value = valueText;  // a bare word is a string
+  json* node = &root;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const std::string& part = parts[i];
+    const bool last = i + 1 == parts.size();
+    if (node->is_array()) {
+      if (!std::all_of(part.begin(), part.end(), ::isdigit) || std::stoul(part) >= node->size())
+        throw InputError("--set", normalisedPath(parts), "no such list item");
+      node = &(*node)[std::stoul(part)];
+    } else {
+      if (!node->is_object()) throw InputError("--set", normalisedPath(parts), "is not inside an object");
+      node = last ? &(*node)[part] : &(*node)[part];
+      if (!last && node->is_null()) *node = json::object();
+    }
+  }
+  *node = value;
+  overridden.insert(normalisedPath(parts));
+}
+
+void validate(Scene& s, const std::string& where) {
+  const int d = s.dimensions;
+  for (int k = 0; k < d; ++k)
+    if (!(s.domain.min[k] < s.domain.max[k]))
+      throw InputError(where, "domain", "min must be below max on every axis");
+  for (size_t i = 0; i < s.fluids.size(); ++i) {
+    const std::string key = "fluids[" + std::to_string(i) + "].box";
+    const Box& b = s.fluids[i].box;
+    for (int k = 0; k < d; ++k) {
+      if (!(b.min[k] < b.max[k])) throw InputError(where, key, "min must be below max on every axis");
+      if (b.min[k] < s.domain.min[k] || b.max[k] > s.domain.max[k])
+        throw InputError(where, key, "lies outside the domain");
+    }
+  }
+  const double spacing = s.particle_spacing;
+  const size_t count = s.particleCount();
+  if (count == 0)
+    throw InputError(where, "fluids",
+                     "the fluid boxes hold no particles at particle_spacing " + formatNumber(spacing));
+  const double bytes = double(count) * double(bytesPerParticleEstimate(d));
+  const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  if (count > (size_t(1) << 31) || bytes > 0.8 * memory)
+    throw InputError(where, "particle_spacing",
+                     std::to_string(count) + " particles need about " + formatNumber(std::ceil(bytes / 1e9)) +
+                         " GB, more than this machine's " + formatNumber(std::floor(memory / 1e9)) + " GB");
+
+  SolverSettings& solver = s.solver;
+  if (solver.kernel_radius == 0) solver.kernel_radius = 2 * spacing;
+  if (solver.kernel_radius <= spacing)
+    throw InputError(where, "solver.kernel_radius", "must exceed particle_spacing, or particles have no neighbours");
+  double cells = 1;
+  for (int k = 0; k < d; ++k) cells *= std::ceil((s.domain.max[k] - s.domain.min[k]) / solver.kernel_radius) + 2;
+  if (cells > double(1 << 28))
+    throw InputError(where, "domain", "spans " + formatNumber(cells) + " cells of the kernel radius; at most 2^28");
+
+  SurfaceSettings& surface = s.surface;
+  if (surface.particle_radius == 0) surface.particle_radius = spacing;
+  if (surface.voxel_size == 0) surface.voxel_size = surface.particle_radius / 2;
+  if (surface.voxel_size > surface.particle_radius / 1.5)
+    throw InputError(where, "surface.voxel_size",
+                     "above particle_radius / 1.5: OpenVDB would drop every particle sphere");
+
+  CameraSettings& camera = s.render.camera;
+  if (camera.position == camera.look_at) {
+    // Frame the domain: look at its centre from the front, raised and turned a little (straight on in 2D).
+    const Eigen::Vector3d centre = 0.5 * (s.domain.min + s.domain.max);
+    const Eigen::Vector3d extent = s.domain.max - s.domain.min;
+    const double tanHalf = std::tan(camera.fov * M_PI / 360.0);
+    const double aspect = double(s.render.width) / double(s.render.height);
+    const double fitHeight = 0.5 * extent.y() / tanHalf;
+    const double fitWidth = 0.5 * extent.x() / (tanHalf * aspect);
+    const double distance = 1.15 * std::max(fitHeight, fitWidth) + 0.5 * extent.z();
+    const Eigen::Vector3d direction =
+        d == 2 ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(0.35, 0.55, 1.0).normalized();
+    camera.look_at = centre - (d == 2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0, 0.15 * extent.y(), 0));
+    camera.position = camera.look_at + distance * direction;
+  }
+}
+
+}  // namespace
+
+Eigen::Array3i latticeCounts(const Scene& scene, const Box& box) {
+  Eigen::Array3i counts(1, 1, 1);
+  for (int k = 0; k < scene.dimensions; ++k) {
+    const double n = std::floor((box.max[k] - box.min[k]) / scene.particle_spacing + 1e-6);
+    counts[k] = static_cast<int>(std::min(std::max(n, 0.0), 2e9));
+  }
+  return counts;
+}
+
+size_t Scene::particleCount() const {
+  size_t total = 0;
+  for (const FluidBlock& fluid : fluids) {
+    const Eigen::Array3i n = latticeCounts(*this, fluid.box);
+    total += size_t(n[0]) * size_t(n[1]) * size_t(n[2]);
+  }
+  return total;
+}
+
+size_t bytesPerParticleEstimate(int dimensions) {
+  // PBF: position, velocity, predicted position (3 x 12), lambda, density, id, cell (4 x 4), the sort's scratch
+  // copy (40), and about 40 neighbours of 4 bytes each in 3D (about 13 in 2D).
+  return dimensions == 3 ? 36 + 16 + 40 + 160 + 8 : 36 + 16 + 40 + 52 + 8;
+}
+
+Scene parseScene(const std::string& text, const std::string& where, const std::vector<std::string>& overrides) {
+  json root = json::parse(text, nullptr, false);
+  if (root.is_discarded()) {
+    // Re-parse with exceptions to learn where the syntax error is.
+    try {
+      json unused = json::parse(text);
+      (void)unused;
+    } catch (const json::parse_error& e) {
+      std::string message = e.what();
+      const auto colon = message.find("] ");
+      throw InputError(where, "byte " + std::to_string(e.byte),
+                       "invalid JSON" + (colon == std::string::npos ? "" : " (" + message.substr(colon + 2) + ")"));
+    }
+  }
+  std::set<std::string> overridden;
+  if (root.is_object())
+    for (const std::string& assignment : overrides) applyOverride(root, assignment, overridden);
+  Scene scene;
+  JsonReader reader(root, where, scene, overridden);
+  visitScene(scene, reader);
+  reader.finish();
+  validate(scene, where);
+  return scene;
+}
+
+Scene loadScene(const fs::path& path, const std::vector<std::string>& overrides) {
+  return parseScene(readTextFile(path), path.string(), overrides);
+}
+
+std::string sceneToJson(const Scene& scene) {
+  Scene copy = scene;
+  JsonWriter writer(copy);
+  visitScene(copy, writer);
+  return writer.root().dump(2) + "\n";
+}
+
+std::string sceneKeysMarkdown() {
+  Scene defaults;
+  KeyTable table;
+  visitScene(defaults, table);
+  return "| key | type | default | allowed | meaning |\n|---|---|---|---|---|\n" + table.rows;
+}
+
+}  // namespace surge

@@ -1,0 +1,94 @@
+// A scene: what to simulate, surface and render. Read from JSON into these typed structs; every key is
+// declared once, in scene_fields.cpp, with its default, range and description (docs/scene-format.md is
+// generated from that declaration by `surge keys`). SI units, y up; in 2D, vectors have two components and z
+// is zero here.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "core/files.h"
+
+namespace surge {
+
+struct Box {
+  Eigen::Vector3d min = Eigen::Vector3d::Zero();
+  Eigen::Vector3d max = Eigen::Vector3d::Zero();
+};
+
+struct FluidBlock {
+  Box box;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+};
+
+struct SolverSettings {
+  std::string method = "pbf";
+  int substeps = 4;
+  int iterations = 4;
+  double kernel_radius = 0;  // 0 in the file: 2 x particle_spacing (resolved on load)
+  double rest_density = 1000;
+  double relaxation_epsilon = 0.01;
+};
+
+struct OutputSettings {
+  double fps = 30;
+  int frames = 90;
+};
+
+struct SurfaceSettings {
+  double particle_radius = 0;  // 0 in the file: particle_spacing (resolved on load)
+  double voxel_size = 0;       // 0 in the file: particle_radius / 2 (resolved on load)
+  double adaptivity = 0;
+};
+
+struct CameraSettings {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // position == look_at: frame the domain (resolved)
+  Eigen::Vector3d look_at = Eigen::Vector3d::Zero();
+  double fov = 40;  // vertical field of view in degrees
+};
+
+struct RenderSettings {
+  int width = 960;
+  int height = 540;
+  int samples = 4;  // per pixel
+  CameraSettings camera;
+  Eigen::Vector3d water_color = Eigen::Vector3d(0.15, 0.45, 0.8);
+};
+
+struct Scene {
+  std::string name;
+  int dimensions = 3;
+  Box domain;
+  double particle_spacing = 0;
+  std::vector<FluidBlock> fluids;
+  Eigen::Vector3d gravity = Eigen::Vector3d(0, -9.81, 0);
+  SolverSettings solver;
+  OutputSettings output;
+  SurfaceSettings surface;
+  RenderSettings render;
+
+  // Particles the fluid boxes hold on the lattice of particle_spacing.
+  size_t particleCount() const;
+};
+
+// Lattice points of one fluid box: counts per axis (1 on unused axes in 2D).
+Eigen::Array3i latticeCounts(const Scene& scene, const Box& box);
+
+// Loads a scene file, applies `overrides` ("key.path=value", from --set) and checks it; derived defaults are
+// resolved. Throws InputError naming the file (or --set) and the key.
+Scene loadScene(const fs::path& path, const std::vector<std::string>& overrides = {});
+// The same from JSON text; `where` names the source in messages.
+Scene parseScene(const std::string& text, const std::string& where,
+                 const std::vector<std::string>& overrides = {});
+
+// The scene as JSON text with every key (the resolved scene saved as scene.json in the output folder).
+std::string sceneToJson(const Scene& scene);
+
+// A markdown table of every key: path, type, default, allowed values, meaning.
+std::string sceneKeysMarkdown();
+
+// Bytes the simulator needs per particle at peak, for the memory check and for reporting.
+size_t bytesPerParticleEstimate(int dimensions);
+
+}  // namespace surge

@@ -1,0 +1,101 @@
+// Every scene key, declared once. Keep docs/scene-format.md in step by running `surge keys`.
+#include "core/scene_fields.h"
+
+namespace surge {
+namespace {
+
+FieldInfo info(const char* description, const char* units = "") {
+  FieldInfo f;
+  f.description = description;
+  f.units = units;
+  return f;
+}
+FieldInfo required(const char* description, const char* units = "") {
+  FieldInfo f = info(description, units);
+  f.required = true;
+  return f;
+}
+FieldInfo positive(const char* description, const char* units = "", bool isRequired = false) {
+  FieldInfo f = info(description, units);
+  f.min = 0;
+  f.minExclusive = true;
+  f.required = isRequired;
+  return f;
+}
+FieldInfo atLeast(double min, const char* description, const char* units = "", double max = 1e300) {
+  FieldInfo f = info(description, units);
+  f.min = min;
+  f.max = max;
+  return f;
+}
+
+void visitBox(SceneVisitor& v, const char* key, Box& box, const char* what) {
+  v.group(key, required(what), [&] {
+    v.vector("min", box.min, required("lower corner", "m"));
+    v.vector("max", box.max, required("upper corner", "m"));
+  });
+}
+
+}  // namespace
+
+void visitScene(Scene& s, SceneVisitor& v) {
+  v.text("name", s.name, required("the scene's name; the default output folder is out/<name>"));
+  {
+    FieldInfo dims = required("2 or 3; in 2D every vector has two components");
+    dims.min = 2;
+    dims.max = 3;
+    v.integer("dimensions", s.dimensions, dims);
+  }
+  visitBox(v, "domain", s.domain, "the tank: an axis-aligned box whose walls are solid");
+  v.real("particle_spacing", s.particle_spacing,
+         positive("initial lattice spacing; the particle radius is half of it", "m", true));
+  v.list(
+      "fluids", required("blocks of fluid, each filled with particles on the lattice"),
+      [&] { return s.fluids.size(); }, [&](size_t n) { s.fluids.resize(n); },
+      [&](size_t i) {
+        FluidBlock& f = s.fluids[i];
+        visitBox(v, "box", f.box, "the block, filled with particles at cell centres of the lattice");
+        v.vector("velocity", f.velocity, info("initial velocity", "m/s"));
+      });
+  v.vector("gravity", s.gravity, info("gravitational acceleration", "m/s^2"));
+
+  v.group("solver", info("the simulator"), [&] {
+    v.choice("method", s.solver.method, {"pbf"}, info("pbf: Position Based Fluids (Macklin & Mueller 2013)"));
+    v.integer("substeps", s.solver.substeps, atLeast(1, "time steps per output frame", "", 100000));
+    v.integer("iterations", s.solver.iterations, atLeast(1, "PBF: Jacobi iterations per step", "", 10000));
+    v.real("kernel_radius", s.solver.kernel_radius,
+           atLeast(0, "SPH kernel radius h; 0 means 2 x particle_spacing", "m"));
+    v.real("rest_density", s.solver.rest_density, positive("rest density rho_0", "kg/m^3"));
+    v.real("relaxation_epsilon", s.solver.relaxation_epsilon,
+           atLeast(0, "PBF eq. 11 relaxation epsilon, as a fraction of the rest lattice's sum of squared "
+                      "constraint gradients (0.01 softens the constraint by 1%)"));
+  });
+  v.group("output", info("what the simulator writes"), [&] {
+    v.real("fps", s.output.fps, positive("output frames per simulated second (and the video's frame rate)"));
+    v.integer("frames", s.output.frames, atLeast(1, "frames to simulate after frame 0", "", 1e7));
+  });
+  v.group("surface", info("the surfacer"), [&] {
+    v.real("particle_radius", s.surface.particle_radius,
+           atLeast(0, "radius of each particle's sphere in the level set; 0 means particle_spacing", "m"));
+    v.real("voxel_size", s.surface.voxel_size,
+           atLeast(0, "level-set voxel size; 0 means particle_radius / 2 (never above particle_radius / 1.5, "
+                      "below which OpenVDB would drop particles)",
+                   "m"));
+    v.real("adaptivity", s.surface.adaptivity, atLeast(0, "volumeToMesh adaptivity, 0 (uniform) to 1", "", 1));
+  });
+  v.group("render", info("the renderer"), [&] {
+    v.integer("width", s.render.width, atLeast(16, "image width", "pixels", 16384));
+    v.integer("height", s.render.height, atLeast(16, "image height", "pixels", 16384));
+    v.integer("samples", s.render.samples, atLeast(1, "samples per pixel", "", 65536));
+    v.group("camera", info("the camera; leave position equal to look_at to frame the domain"), [&] {
+      v.vector("position", s.render.camera.position, info("eye position", "m"), true);
+      v.vector("look_at", s.render.camera.look_at, info("point at the image centre", "m"), true);
+      FieldInfo fov = positive("vertical field of view", "degrees");
+      fov.max = 170;
+      v.real("fov", s.render.camera.fov, fov);
+    });
+    v.vector("water_color", s.render.water_color, atLeast(0, "linear RGB colour of the water", "", 1), true);
+  });
+}
+
+}  // namespace surge

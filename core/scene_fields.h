@@ -1,0 +1,42 @@
+// The declaration of every scene key, once: a visitor walks the Scene and names each field with its
+// description and allowed range. Readers (JSON), writers (scene.json) and the key documentation are visitors.
+#pragma once
+
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/scene.h"
+
+namespace surge {
+
+struct FieldInfo {
+  const char* description = "";
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  bool minExclusive = false;
+  bool required = false;
+  const char* units = "";
+};
+
+class SceneVisitor {
+ public:
+  virtual ~SceneVisitor() = default;
+  virtual void text(const char* key, std::string& value, const FieldInfo& info) = 0;
+  virtual void choice(const char* key, std::string& value, const std::vector<std::string>& options,
+                      const FieldInfo& info) = 0;
+  virtual void integer(const char* key, int& value, const FieldInfo& info) = 0;
+  virtual void real(const char* key, double& value, const FieldInfo& info) = 0;
+  // A vector of `dimensions` components (the scene's, or 3 when `always3`).
+  virtual void vector(const char* key, Eigen::Vector3d& value, const FieldInfo& info, bool always3 = false) = 0;
+  virtual void group(const char* key, const FieldInfo& info, const std::function<void()>& body) = 0;
+  // A list of objects: size(), resize(n), and visitItem(i) which visits item i's fields.
+  virtual void list(const char* key, const FieldInfo& info, const std::function<size_t()>& size,
+                    const std::function<void(size_t)>& resize, const std::function<void(size_t)>& visitItem) = 0;
+};
+
+// Visits every key of the scene, in file order.
+void visitScene(Scene& scene, SceneVisitor& visitor);
+
+}  // namespace surge
