@@ -372,7 +372,7 @@ void validate(Scene& s, const std::string& where) {
     const double aspect = double(s.render.width) / double(s.render.height);
     const double fitHeight = 0.5 * extent.y() / tanHalf;
     const double fitWidth = 0.5 * extent.x() / (tanHalf * aspect);
-    const double distance = 1.15 * std::max(fitHeight, fitWidth) + 0.5 * extent.z();
+    const double distance = 1.4 * std::max(fitHeight, fitWidth) + 0.5 * extent.z();
     const Eigen::Vector3d direction =
         d == 2 ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(0.35, 0.55, 1.0).normalized();
     camera.look_at = centre - (d == 2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0, 0.15 * extent.y(), 0));

@@ -69,6 +69,21 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.real("relaxation_epsilon", s.solver.relaxation_epsilon,
            atLeast(0, "PBF eq. 11 relaxation epsilon, as a fraction of the rest lattice's sum of squared "
                       "constraint gradients (0.01 softens the constraint by 1%)"));
+    v.real("max_density_error", s.solver.max_density_error,
+           atLeast(0, "PBF: when > 0, iterate until the average density error (a fraction) is under it, at most "
+                      "`iterations` times; 0 runs exactly `iterations`"));
+    v.real("scorr_k", s.solver.scorr_k,
+           atLeast(0, "PBF eq. 13 artificial pressure k, in units of the rest lattice's lambda; 0 turns s_corr off"));
+    v.real("scorr_n", s.solver.scorr_n, positive("PBF eq. 13 exponent n"));
+    {
+      FieldInfo dq = positive("PBF eq. 13 delta q, as a fraction of the kernel radius (paper: 0.1 to 0.3)");
+      dq.max = 1;
+      v.real("scorr_delta_q", s.solver.scorr_delta_q, dq);
+    }
+    v.real("vorticity_epsilon", s.solver.vorticity_epsilon,
+           atLeast(0, "PBF eq. 16 vorticity confinement epsilon; 0 turns it off", "m/s"));
+    v.real("xsph_c", s.solver.xsph_c,
+           atLeast(0, "PBF eq. 17 XSPH viscosity c (weights scaled by the particle volume); 0 turns it off", "", 1));
   });
   v.group("output", info("what the simulator writes"), [&] {
     v.real("fps", s.output.fps, positive("output frames per simulated second (and the video's frame rate)"));

@@ -1,0 +1,46 @@
+// The `surge` subcommands, one file each. Each registers its CLI11 options and the function that runs it.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/files.h"
+#include "core/progress.h"
+#include "core/scene.h"
+
+namespace surge {
+
+// Options every subcommand shares (DESIGN.md: --out, --set, --threads, --quiet).
+struct CommonOptions {
+  std::string out;
+  std::vector<std::string> overrides;
+  int threads = 0;
+  bool quiet = false;
+};
+
+void addCommonOptions(CLI::App& command, CommonOptions& options, bool withOut);
+
+// The output folder: --out, or out/<scene name>.
+fs::path outputFolder(const CommonOptions& options, const Scene& scene);
+// The scene of an output folder (its scene.json) with --set applied.
+Scene sceneOfFolder(const fs::path& dir, const CommonOptions& options);
+// Prints a line to stdout unless --quiet.
+void say(const CommonOptions& options, const std::string& line);
+
+// Each adds a subcommand to `app` and returns nothing; the command's callback does the work.
+void addRunCommand(CLI::App& app);
+void addSimCommand(CLI::App& app);
+void addSurfaceCommand(CLI::App& app);
+void addRenderCommand(CLI::App& app);
+void addVideoCommand(CLI::App& app);
+void addKeysCommand(CLI::App& app);
+
+// The stages, shared by their own subcommands and by `surge run`.
+void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const CommonOptions& options);
+void runSurfaceStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options);
+void runRenderStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options);
+void runVideoStage(const Scene& scene, const fs::path& dir, const CommonOptions& options);
+
+}  // namespace surge

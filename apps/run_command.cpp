@@ -1,0 +1,32 @@
+// surge run SCENE: all four stages, sim -> surface -> render -> video, into one output folder.
+#include "apps/commands.h"
+#include "core/parallel.h"
+
+namespace surge {
+
+void addRunCommand(CLI::App& app) {
+  struct Options {
+    CommonOptions common;
+    std::string scene;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* command = app.add_subcommand("run", "simulate, surface, render and make the video of a scene");
+  command->add_option("scene", options->scene, "scene file (JSON)")->required();
+  addCommonOptions(*command, options->common, true);
+  command->callback([options] {
+    const Scene scene = loadScene(options->scene, options->common.overrides);
+    ThreadLimit threads(options->common.threads);
+    const fs::path dir = outputFolder(options->common, scene);
+    runSimStage(scene, dir, false, options->common);
+    runSurfaceStage(scene, dir, FrameRange{}, options->common);
+    runRenderStage(scene, dir, FrameRange{}, options->common);
+    runVideoStage(scene, dir, options->common);
+  });
+}
+
+void addKeysCommand(CLI::App& app) {
+  CLI::App* command = app.add_subcommand("keys", "print every scene key as a markdown table (docs/scene-format.md)");
+  command->callback([] { std::fputs(sceneKeysMarkdown().c_str(), stdout); });
+}
+
+}  // namespace surge

@@ -1,0 +1,35 @@
+// surge video DIR: PNG frames to an H.264 MP4 with ffmpeg.
+#include <chrono>
+#include <cstdio>
+
+#include "apps/commands.h"
+#include "render/video.h"
+
+namespace surge {
+
+void runVideoStage(const Scene& scene, const fs::path& dir, const CommonOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  TerminalProgress progress(!options.quiet);
+  makeVideo(dir, scene, progress);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  char line[256];
+  std::snprintf(line, sizeof line, "video: %.1f s -> %s", seconds, (dir / (scene.name + ".mp4")).string().c_str());
+  say(options, line);
+}
+
+void addVideoCommand(CLI::App& app) {
+  struct Options {
+    CommonOptions common;
+    std::string dir;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* command = app.add_subcommand("video", "assemble frames/frame_NNNNN.png into <name>.mp4 (ffmpeg)");
+  command->add_option("dir", options->dir, "output folder of surge render")->required();
+  addCommonOptions(*command, options->common, false);
+  command->callback([options] {
+    const Scene scene = sceneOfFolder(options->dir, options->common);
+    runVideoStage(scene, options->dir, options->common);
+  });
+}
+
+}  // namespace surge

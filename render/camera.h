@@ -1,0 +1,59 @@
+// A pinhole camera: y is up, the image's x grows to the right and its y downwards, so a camera looking down
+// -z shows world +x on the right of the image. The vertical field of view is in degrees.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "core/scene.h"
+
+namespace surge {
+
+struct Ray {
+  Eigen::Vector3f origin = Eigen::Vector3f::Zero();
+  Eigen::Vector3f direction = Eigen::Vector3f::UnitZ();  // unit length
+};
+
+class PinholeCamera {
+ public:
+  PinholeCamera(const CameraSettings& settings, int width, int height)
+      : position_(settings.position.cast<float>()), width_(float(width)), height_(float(height)) {
+    forward_ = (settings.look_at - settings.position).cast<float>().normalized();
+    // Looking straight up or down leaves "up" undefined: take -z (or +z) as the image's up then.
+    Eigen::Vector3f worldUp = Eigen::Vector3f::UnitY();
+    if (std::abs(forward_.dot(worldUp)) > 0.999f)
+      worldUp = forward_.y() > 0 ? Eigen::Vector3f(0, 0, 1) : Eigen::Vector3f(0, 0, -1);
+    right_ = forward_.cross(worldUp).normalized();
+    up_ = right_.cross(forward_);
+    tanHalfHeight_ = float(std::tan(settings.fov * M_PI / 360.0));
+    tanHalfWidth_ = tanHalfHeight_ * width_ / height_;
+  }
+
+  // The ray through image point (x, y) in pixels: (0, 0) is the top-left corner of the image, (width, height)
+  // the bottom-right one, and the centre of pixel (i, j) is (i + 0.5, j + 0.5).
+  Ray rayThrough(float x, float y) const {
+    const float sx = (2.0f * x / width_ - 1.0f) * tanHalfWidth_;
+    const float sy = (1.0f - 2.0f * y / height_) * tanHalfHeight_;
+    Ray ray;
+    ray.origin = position_;
+    ray.direction = (forward_ + sx * right_ + sy * up_).normalized();
+    return ray;
+  }
+
+  // Where a world point lands in the image, in the pixel units of rayThrough; false if it is behind the
+  // camera.
+  bool project(const Eigen::Vector3f& point, float& x, float& y) const {
+    const Eigen::Vector3f d = point - position_;
+    const float depth = d.dot(forward_);
+    if (depth <= 0) return false;
+    x = 0.5f * width_ * (1.0f + d.dot(right_) / (depth * tanHalfWidth_));
+    y = 0.5f * height_ * (1.0f - d.dot(up_) / (depth * tanHalfHeight_));
+    return true;
+  }
+
+ private:
+  Eigen::Vector3f position_, forward_, right_, up_;
+  float width_, height_, tanHalfWidth_ = 1, tanHalfHeight_ = 1;
+};
+
+}  // namespace surge

@@ -1,0 +1,398 @@
+#include "sim/pbf_solver.h"
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cmath>
+
+#include "core/parallel.h"
+
+namespace surge {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double millisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+template <int Dim>
+Vec<Dim> toVec(const Eigen::Vector3d& v) {
+  return v.head<Dim>().template cast<float>();
+}
+
+}  // namespace
+
+template <int Dim>
+void restLatticeSums(const Kernels<Dim>& kernels, float spacing, double* weightSum, double* gradientSquaredSum) {
+  const int reach = static_cast<int>(std::ceil(kernels.radius() / spacing));
+  double w = 0, g = 0;
+  const int zReach = Dim == 3 ? reach : 0;
+  for (int i = -reach; i <= reach; ++i)
+    for (int j = -reach; j <= reach; ++j)
+      for (int k = -zReach; k <= zReach; ++k) {
+        Vec<Dim> r;
+        r[0] = i * spacing;
+        r[1] = j * spacing;
+        if constexpr (Dim == 3) r[2] = k * spacing;
+        w += kernels.poly6(r.squaredNorm());
+        g += kernels.spikyGradient(r, r.norm()).squaredNorm();
+      }
+  *weightSum = w;
+  *gradientSquaredSum = g;
+}
+
+template <int Dim>
+PbfSolver<Dim>::PbfSolver(const Scene& scene)
+    : kernels_(static_cast<float>(scene.solver.kernel_radius)),
+      grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
+            static_cast<float>(scene.solver.kernel_radius)) {
+  const SolverSettings& s = scene.solver;
+  const float spacing = static_cast<float>(scene.particle_spacing);
+  restDensity_ = static_cast<float>(s.rest_density);
+  // The mass makes an interior particle of the rest lattice have exactly rho_0 (eq. 2 summed over the lattice),
+  // so a block at rest starts unstressed and keeps its volume N x spacing^d.
+  double weightSum = 0, gradientSquaredSum = 0;
+  restLatticeSums(kernels_, spacing, &weightSum, &gradientSquaredSum);
+  mass_ = static_cast<float>(s.rest_density / weightSum);
+  massOverRho_ = mass_ / restDensity_;
+  // sum_k |grad_k C_i|^2 at the rest lattice (eq. 8-9 with C_i = rho_i / rho_0 - 1): the scale of eq. 11's
+  // denominator. epsilon is a fraction of it, s_corr is measured in lambda's units 1 / that sum.
+  latticeGradientSum_ = static_cast<float>(massOverRho_ * massOverRho_ * gradientSquaredSum);
+  epsilon_ = static_cast<float>(s.relaxation_epsilon) * latticeGradientSum_;
+  scorrK_ = static_cast<float>(s.scorr_k);
+  scorrN_ = static_cast<float>(s.scorr_n);
+  const float dq = static_cast<float>(s.scorr_delta_q * s.kernel_radius);
+  scorrInvWdq_ = 1.0f / kernels_.poly6(dq * dq);
+  vorticityEpsilon_ = static_cast<float>(s.vorticity_epsilon);
+  xsphC_ = static_cast<float>(s.xsph_c);
+  iterations_ = s.iterations;
+  maxDensityError_ = s.max_density_error;
+  gravity_ = toVec<Dim>(scene.gravity);
+  domainMin_ = toVec<Dim>(scene.domain.min);
+  domainMax_ = toVec<Dim>(scene.domain.max);
+  const float particleRadius = 0.5f * spacing;
+  wallMin_ = domainMin_ + VecD::Constant(particleRadius);
+  wallMax_ = domainMax_ - VecD::Constant(particleRadius);
+
+  // Wall boundary: a particle at distance d from a wall sees the rest lattice continued beyond the wall, its
+  // layers at d + spacing / 2 + k spacing, tangentially aligned with the particle. So a particle of the rest
+  // lattice next to a wall has rho_0 as an interior one does, and is pushed off the wall by its own constraint
+  // instead of piling up against it (after the boundary particles of Akinci et al. 2012, summed once here).
+  const float h = kernels_.radius();
+  const int reach = static_cast<int>(std::ceil(h / spacing)) + 1;
+  wallWeight_.assign(kWallTableSize + 1, 0.0f);
+  wallGradient_.assign(kWallTableSize + 1, 0.0f);
+  wallTableScale_ = kWallTableSize / h;
+  for (int t = 0; t <= kWallTableSize; ++t) {
+    const float d = h * t / kWallTableSize;
+    double weight = 0, gradient = 0;
+    for (int layer = 0; layer <= reach; ++layer)
+      for (int a = -reach; a <= reach; ++a)
+        for (int b = (Dim == 3 ? -reach : 0); b <= (Dim == 3 ? reach : 0); ++b) {
+          VecD r = VecD::Zero();  // p_i - p_b with the wall normal along axis 0
+          r[0] = d + 0.5f * spacing + layer * spacing;
+          r[1] = a * spacing;
+          if constexpr (Dim == 3) r[2] = b * spacing;
+          weight += kernels_.poly6(r.squaredNorm());
+          gradient += kernels_.spikyGradient(r, r.norm())[0];  // <= 0: towards the wall
+        }
+    wallWeight_[t] = static_cast<float>(weight);
+    wallGradient_[t] = static_cast<float>(-gradient);
+  }
+}
+
+template <int Dim>
+void PbfSolver<Dim>::addWallTerms(const VecD& p, float& weight, VecD& gradient) const {
+  for (int k = 0; k < Dim; ++k)
+    for (int side = 0; side < 2; ++side) {
+      const float d = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
+      const float u = std::max(d, 0.0f) * wallTableScale_;
+      if (u >= kWallTableSize) continue;
+      const int t = static_cast<int>(u);
+      const float f = u - t;
+      weight += (1 - f) * wallWeight_[t] + f * wallWeight_[t + 1];
+      const float g = (1 - f) * wallGradient_[t] + f * wallGradient_[t + 1];
+      gradient[k] += side == 0 ? -g : g;  // grad_{p_i} points towards the wall
+    }
+}
+
+template <int Dim>
+void PbfSolver<Dim>::setParticles(const ParticleFrame& frame) {
+  const size_t n = frame.size();
+  x_.resize(n);
+  v_.resize(n);
+  p_.resize(n);
+  delta_.resize(n);
+  id_ = frame.id;
+  lambda_.assign(n, 0.0f);
+  density_.assign(n, 0.0f);
+  for (size_t i = 0; i < n; ++i) {
+    x_[i] = frame.position[i].head<Dim>();
+    v_[i] = frame.velocity[i].head<Dim>();
+  }
+  if (vorticityEpsilon_ > 0) (Dim == 3 ? omega3_.resize(n) : omega2_.resize(n));
+}
+
+template <int Dim>
+void PbfSolver<Dim>::getParticles(ParticleFrame& frame) const {
+  const size_t n = x_.size();
+  frame.dimensions = Dim;
+  frame.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    frame.position[i].setZero();
+    frame.velocity[i].setZero();
+    frame.position[i].head<Dim>() = x_[i];
+    frame.velocity[i].head<Dim>() = v_[i];
+  }
+  frame.id = id_;
+}
+
+template <int Dim>
+long PbfSolver<Dim>::step(float dt) {
+  predictPositions(dt);
+  findNeighbors();
+  solveDensityConstraints();
+  updateVelocities(dt);
+  if (vorticityEpsilon_ > 0) applyVorticityConfinement(dt);
+  if (xsphC_ > 0) applyXsphViscosity();
+  x_.swap(p_);  // line 23: x_i = x*_i
+  return firstBadParticle();
+}
+
+// Algorithm 1, lines 1-4: v_i += dt f_ext(x_i); x*_i = x_i + dt v_i. The walls act on x* at once.
+template <int Dim>
+void PbfSolver<Dim>::predictPositions(float dt) {
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      v_[i] += dt * gravity_;
+      p_[i] = x_[i] + dt * v_[i];
+      clampToWalls(p_[i]);
+    }
+  });
+}
+
+// Lines 5-7: neighbours of x*. Particles are reordered by cell first, every step, for memory locality.
+template <int Dim>
+void PbfSolver<Dim>::findNeighbors() {
+  const auto start = Clock::now();
+  grid_.sort(p_);
+  const std::vector<uint32_t>& order = grid_.sortedOrder();
+  gatherByOrder(order, x_, scratch_);
+  gatherByOrder(order, v_, scratch_);
+  gatherByOrder(order, p_, scratch_);
+  gatherByOrder(order, id_, scratchIds_);
+  grid_.findNeighbors(p_, kernels_.radius(), neighbors_);
+  times_.neighbors += millisecondsSince(start);
+}
+
+// Lines 8-19: Jacobi iterations on the density constraints. With solver.max_density_error > 0 the loop stops
+// early once the average density error is under it; solver.iterations caps it either way.
+template <int Dim>
+void PbfSolver<Dim>::solveDensityConstraints() {
+  const auto start = Clock::now();
+  lastIterations_ = 0;
+  for (int iteration = 0; iteration < iterations_; ++iteration) {
+    const double averageError = computeLambdas();
+    if (maxDensityError_ > 0 && averageError <= maxDensityError_) break;
+    applyPositionCorrections();
+    ++lastIterations_;
+  }
+  times_.constraint += millisecondsSince(start);
+}
+
+// Eq. 2: rho_i = sum_j m W_poly6(p_i - p_j, h). Eq. 1: C_i = rho_i / rho_0 - 1, used one-sided (only
+// compression is corrected, so particles at the free surface do not pull together; s_corr handles clumping).
+// Eq. 8: grad_{p_k} C_i = (m / rho_0) sum_j grad W(p_i - p_j) for k = i, and -(m / rho_0) grad W(p_i - p_k)
+// for k = j. Eq. 11: lambda_i = -C_i / (sum_k |grad_{p_k} C_i|^2 + epsilon).
+template <int Dim>
+double PbfSolver<Dim>::computeLambdas() {
+  const float selfWeight = kernels_.poly6(0.0f);
+  return parallelSum<double>(0, size(), [&](size_t b, size_t e) {
+    double errorSum = 0;
+    for (size_t i = b; i < e; ++i) {
+      float weight = selfWeight;
+      VecD gradientI = VecD::Zero();
+      float gradientSquaredSum = 0;
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
+        const VecD r = p_[i] - p_[*j];
+        const float length = r.norm();
+        weight += kernels_.poly6(length * length);
+        const VecD gradientJ = massOverRho_ * kernels_.spikyGradient(r, length);
+        gradientI += gradientJ;
+        gradientSquaredSum += gradientJ.squaredNorm();
+      }
+      VecD wallGradient = VecD::Zero();
+      addWallTerms(p_[i], weight, wallGradient);
+      gradientI += massOverRho_ * wallGradient;
+      density_[i] = mass_ * weight;
+      const float constraint = std::max(density_[i] / restDensity_ - 1.0f, 0.0f);
+      lambda_[i] = -constraint / (gradientSquaredSum + gradientI.squaredNorm() + epsilon_);
+      errorSum += constraint;
+    }
+    return errorSum;
+  }) / std::max<double>(1, size());
+}
+
+// Eq. 12 with the artificial pressure of eq. 13-14:
+//   delta p_i = (m / rho_0) sum_j (lambda_i + lambda_j + s_corr) grad W_spiky(p_i - p_j, h),
+//   s_corr = -k (W_poly6(p_i - p_j) / W_poly6(delta q))^n, in lambda's units (divided by the rest lattice's
+//   sum of squared gradients) so that k means the same at every resolution.
+// Then collision response (line 17) and x*_i += delta p_i (line 18), as two passes to stay Jacobi.
+template <int Dim>
+void PbfSolver<Dim>::applyPositionCorrections() {
+  const bool scorr = scorrK_ > 0;
+  const float scorrScale = scorrK_ / latticeGradientSum_;
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      VecD delta = VecD::Zero();
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
+        const VecD r = p_[i] - p_[*j];
+        const float length = r.norm();
+        float coefficient = lambda_[i] + lambda_[*j];
+        if (scorr)
+          coefficient -= scorrScale * std::pow(kernels_.poly6(length * length) * scorrInvWdq_, scorrN_);
+        delta += coefficient * kernels_.spikyGradient(r, length);
+      }
+      // The walls do not move and carry no constraint of their own: only lambda_i acts along their gradient.
+      float unusedWeight = 0;
+      VecD wallGradient = VecD::Zero();
+      addWallTerms(p_[i], unusedWeight, wallGradient);
+      delta += lambda_[i] * wallGradient;
+      delta_[i] = massOverRho_ * delta;
+    }
+  });
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      p_[i] += delta_[i];
+      clampToWalls(p_[i]);
+    }
+  });
+}
+
+// Line 21: v_i = (x*_i - x_i) / dt.
+template <int Dim>
+void PbfSolver<Dim>::updateVelocities(float dt) {
+  const float inverseDt = 1.0f / dt;
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) v_[i] = (p_[i] - x_[i]) * inverseDt;
+  });
+}
+
+// Eq. 15: omega_i = sum_j v_ij x grad_{p_j} W(p_i - p_j), v_ij = v_j - v_i (a scalar in 2D).
+// Eq. 16: f_i = epsilon (N x omega_i), N = eta / |eta|, eta = grad |omega|_i = sum_j |omega_j| grad_{p_i} W.
+// The confinement force is applied as an acceleration: v_i += dt f_i.
+template <int Dim>
+void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
+  const auto start = Clock::now();
+  auto omegaMagnitude = [&](size_t j) { return Dim == 3 ? omega3_[j].norm() : std::abs(omega2_[j]); };
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      Eigen::Vector3f omega = Eigen::Vector3f::Zero();
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
+        const VecD r = p_[i] - p_[*j];
+        const VecD gradientJ = -kernels_.spikyGradient(r, r.norm());  // grad with respect to p_j
+        Eigen::Vector3f vij = Eigen::Vector3f::Zero(), g = Eigen::Vector3f::Zero();
+        vij.head<Dim>() = v_[*j] - v_[i];
+        g.head<Dim>() = gradientJ;
+        omega += vij.cross(g);
+      }
+      if constexpr (Dim == 3) omega3_[i] = omega;
+      else omega2_[i] = omega.z();
+    }
+  });
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      VecD eta = VecD::Zero();
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
+        const VecD r = p_[i] - p_[*j];
+        eta += (omegaMagnitude(*j) - omegaMagnitude(i)) * kernels_.spikyGradient(r, r.norm());
+      }
+      const float etaLength = eta.norm();
+      if (etaLength < 1e-12f) continue;
+      Eigen::Vector3f n = Eigen::Vector3f::Zero(), omega;
+      n.head<Dim>() = eta / etaLength;
+      if constexpr (Dim == 3) omega = omega3_[i];
+      else omega = Eigen::Vector3f(0, 0, omega2_[i]);
+      const Eigen::Vector3f force = vorticityEpsilon_ * n.cross(omega);
+      v_[i] += dt * force.head<Dim>();
+    }
+  });
+  times_.vorticity += millisecondsSince(start);
+}
+
+// Eq. 17: v_i <- v_i + c sum_j (m / rho_0) v_ij W(p_i - p_j, h), with v_ij = v_j - v_i. The factor m / rho_0
+// (the particle volume) makes c dimensionless, as the paper's c = 0.01 assumes unit particle volume.
+template <int Dim>
+void PbfSolver<Dim>::applyXsphViscosity() {
+  const auto start = Clock::now();
+  scratch_.resize(size());
+  const float scale = xsphC_ * massOverRho_;
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      VecD sum = VecD::Zero();
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j)
+        sum += (v_[*j] - v_[i]) * kernels_.poly6((p_[i] - p_[*j]).squaredNorm());
+      scratch_[i] = v_[i] + scale * sum;
+    }
+  });
+  v_.swap(scratch_);
+  times_.viscosity += millisecondsSince(start);
+}
+
+template <int Dim>
+void PbfSolver<Dim>::clampToWalls(VecD& p) const {
+  p = p.cwiseMax(wallMin_).cwiseMin(wallMax_);
+}
+
+template <int Dim>
+long PbfSolver<Dim>::firstBadParticle() const {
+  for (size_t i = 0; i < size(); ++i) {
+    const bool finite = x_[i].allFinite() && v_[i].allFinite();
+    const bool inside = (x_[i].array() >= domainMin_.array()).all() && (x_[i].array() <= domainMax_.array()).all();
+    if (!finite || !inside) return static_cast<long>(i);
+  }
+  return -1;
+}
+
+// Density error of DESIGN.md at the current positions, with the neighbour lists of the last step.
+template <int Dim>
+FluidMeasures PbfSolver<Dim>::measure() {
+  struct Sums {
+    double errorSum = 0, errorMax = 0, energy = 0;
+    Sums& operator+=(const Sums& o) {
+      errorSum += o.errorSum;
+      errorMax = std::max(errorMax, o.errorMax);
+      energy += o.energy;
+      return *this;
+    }
+  };
+  if (neighbors_.offsets.size() != size() + 1) {
+    p_ = x_;  // before the first step: neighbours of the current positions
+    findNeighbors();
+  }
+  const float selfWeight = kernels_.poly6(0.0f);
+  const Sums sums = parallelSum<Sums>(0, size(), [&](size_t b, size_t e) {
+    Sums s;
+    for (size_t i = b; i < e; ++i) {
+      float weight = selfWeight;
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j)
+          weight += kernels_.poly6((x_[i] - x_[*j]).squaredNorm());
+      const double error = std::max(double(mass_ * weight / restDensity_) - 1.0, 0.0);
+      s.errorSum += error;
+      s.errorMax = std::max(s.errorMax, error);
+      s.energy += 0.5 * mass_ * v_[i].squaredNorm();
+    }
+    return s;
+  });
+  FluidMeasures m;
+  m.densityErrorAvg = size() ? sums.errorSum / double(size()) : 0;
+  m.densityErrorMax = sums.errorMax;
+  m.kineticEnergy = sums.energy;
+  return m;
+}
+
+template class PbfSolver<2>;
+template class PbfSolver<3>;
+template void restLatticeSums(const Kernels<2>&, float, double*, double*);
+template void restLatticeSums(const Kernels<3>&, float, double*, double*);
+
+}  // namespace surge

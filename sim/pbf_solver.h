@@ -1,0 +1,109 @@
+// Position Based Fluids, Macklin & Mueller, SIGGRAPH 2013 ("the paper"), in 2D and 3D.
+// One step is the paper's Algorithm 1, split into named phases:
+//   predictPositions        lines 1-4   apply external forces, predict x*
+//   findNeighbors           lines 5-7   sort into the grid, reorder particles, build neighbour lists
+//   solveDensityConstraints lines 8-19  Jacobi iterations: lambda (eq. 11), delta p with s_corr (eq. 12-14),
+//                                       collision response, x* += delta p
+//   updateVelocities        line 21     v = (x* - x) / dt
+//   vorticity + XSPH        line 22     vorticity confinement (eq. 15-16), XSPH viscosity (eq. 17)
+//   commit                  line 23     x = x*
+// Every loop gathers over neighbours and writes only its own particle, so results do not depend on the thread
+// count. A feature the scene turns off (s_corr k = 0, vorticity epsilon = 0, XSPH c = 0) runs no pass and holds
+// no memory.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/ply.h"
+#include "core/scene.h"
+#include "sim/kernels.h"
+#include "sim/neighbor_grid.h"
+
+namespace surge {
+
+// Milliseconds spent per phase, accumulated until reset.
+struct PhaseTimes {
+  double neighbors = 0, constraint = 0, vorticity = 0, viscosity = 0;
+};
+
+// Density error as DESIGN.md defines it (compression only, as a fraction of rho_0) and kinetic energy.
+struct FluidMeasures {
+  double densityErrorAvg = 0, densityErrorMax = 0, kineticEnergy = 0;
+};
+
+template <int Dim>
+class PbfSolver {
+ public:
+  using VecD = Vec<Dim>;
+
+  explicit PbfSolver(const Scene& scene);
+
+  void setParticles(const ParticleFrame& frame);
+  void getParticles(ParticleFrame& frame) const;
+  size_t size() const { return x_.size(); }
+
+  // One time step of Algorithm 1. Returns the index of the first particle whose state is not finite or lies
+  // outside the domain afterwards, or -1 if all are well.
+  long step(float dt);
+
+  FluidMeasures measure();
+  int lastIterations() const { return lastIterations_; }
+  PhaseTimes& phaseTimes() { return times_; }
+  uint32_t particleId(size_t i) const { return id_[i]; }
+  float particleMass() const { return mass_; }
+  const std::vector<VecD>& positions() const { return x_; }
+
+ private:
+  void predictPositions(float dt);
+  void findNeighbors();
+  void solveDensityConstraints();
+  double computeLambdas();  // returns the average density error before this iteration's correction
+  void applyPositionCorrections();
+  void updateVelocities(float dt);
+  void applyVorticityConfinement(float dt);
+  void applyXsphViscosity();
+  void clampToWalls(VecD& p) const;
+  // Adds the walls' share of eq. 2 and eq. 8 for a particle at p: to the kernel weight sum and to
+  // sum_j grad W (both before the factor m or m / rho_0).
+  void addWallTerms(const VecD& p, float& weight, VecD& gradient) const;
+  long firstBadParticle() const;
+
+  // Parameters, fixed at construction.
+  Kernels<Dim> kernels_;
+  float restDensity_, mass_, massOverRho_, epsilon_, latticeGradientSum_;
+  float scorrK_, scorrN_, scorrInvWdq_;
+  float vorticityEpsilon_, xsphC_;
+  int iterations_;
+  double maxDensityError_;
+  VecD gravity_, wallMin_, wallMax_, domainMin_, domainMax_;
+  // The walls as the rest lattice continued beyond them, tabulated against the distance d to the wall
+  // plane in kWallTableSize steps over [0, h]: sum of W, and the normal component of sum of grad W.
+  static constexpr int kWallTableSize = 64;
+  std::vector<float> wallWeight_, wallGradient_;
+  float wallTableScale_ = 0;
+
+  // Particle channels (structure of arrays) and the neighbour grid.
+  std::vector<VecD> x_, v_, p_, delta_;
+  std::vector<uint32_t> id_;
+  std::vector<float> lambda_, density_;
+  std::vector<VecD> omega3_;    // vorticity (3D); allocated only when vorticity confinement is on
+  std::vector<float> omega2_;   // vorticity (2D, a scalar)
+  std::vector<VecD> scratch_;
+  std::vector<uint32_t> scratchIds_;
+  NeighborGrid<Dim> grid_;
+  NeighborLists neighbors_;
+
+  int lastIterations_ = 0;
+  PhaseTimes times_;
+};
+
+extern template class PbfSolver<2>;
+extern template class PbfSolver<3>;
+
+// Lattice sums at rest for an interior particle: sum_j W(r_ij) including j = i, and sum_j |grad W(r_ij)|^2.
+// Used to choose the particle mass so that the rest lattice has density rho_0, and to scale epsilon.
+template <int Dim>
+void restLatticeSums(const Kernels<Dim>& kernels, float spacing, double* weightSum, double* gradientSquaredSum);
+
+}  // namespace surge

@@ -1,0 +1,147 @@
+// Runs the `surge` program as a user would and reads back every stage's files.
+#include <gtest/gtest.h>
+#include <stb/stb_image.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <sys/wait.h>
+
+#include "core/files.h"
+#include "core/ply.h"
+
+namespace surge {
+namespace {
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+};
+
+// Runs surge with `arguments` (a shell-quoted string), capturing stdout and stderr.
+Result runSurge(const std::string& arguments) {
+  const fs::path dir = fs::path(testing::TempDir()) / "surge_e2e_io";
+  fs::create_directories(dir);
+  const std::string command = std::string(SURGE_BINARY) + " " + arguments + " >" + (dir / "out").string() +
+                              " 2>" + (dir / "err").string();
+  Result result;
+  const int raw = std::system(command.c_str());
+  result.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  result.out = readTextFile(dir / "out");
+  result.err = readTextFile(dir / "err");
+  return result;
+}
+
+int countVideoFrames(const fs::path& mp4) {
+  const std::string command = "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+                              "stream=nb_read_frames -of csv=p=0 '" + mp4.string() + "'";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return -1;
+  char buffer[64] = {0};
+  const bool read = std::fgets(buffer, sizeof buffer, pipe) != nullptr;
+  pclose(pipe);
+  return read ? std::atoi(buffer) : -1;
+}
+
+const char* kTinyScene = R"({
+  "name": "tiny",
+  "dimensions": 3,
+  "domain": {"min": [0, 0, 0], "max": [0.6, 0.4, 0.3]},
+  "particle_spacing": 0.03,
+  "fluids": [{"box": {"min": [0, 0, 0], "max": [0.18, 0.24, 0.15]}}],
+  "output": {"fps": 30, "frames": 3},
+  "render": {"width": 160, "height": 96, "samples": 1}
+})";
+
+fs::path writeScene(const std::string& name, const std::string& text) {
+  const fs::path path = fs::path(testing::TempDir()) / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(EndToEnd, RunMakesEveryStagesFiles) {
+  const fs::path scene = writeScene("tiny.json", kTinyScene);
+  const fs::path out = fs::path(testing::TempDir()) / "surge_e2e_tiny";
+  fs::remove_all(out);
+  const Result r = runSurge("run '" + scene.string() + "' --out '" + out.string() + "' --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.out.empty()) << "--quiet prints nothing: " << r.out;
+
+  // 6 x 8 x 5 lattice cells of 0.03 in the fluid box.
+  const size_t particles = 240;
+  EXPECT_EQ(listFrames(out, "particles", "ply"), (std::vector<int>{0, 1, 2, 3}));
+  for (int f = 0; f <= 3; ++f) EXPECT_EQ(readParticlePly(framePath(out, "particles", f, "ply")).size(), particles);
+  // Frame 0 is the lattice at rest; the water has moved by frame 3 (it falls and spreads under gravity).
+  const ParticleFrame first = readParticlePly(framePath(out, "particles", 0, "ply"));
+  const ParticleFrame last = readParticlePly(framePath(out, "particles", 3, "ply"));
+  float speed = 0;
+  for (const auto& v : last.velocity) speed = std::max(speed, v.norm());
+  EXPECT_GT(speed, 0.05f);
+
+  // stats.csv: a header and one row per frame.
+  std::ifstream stats(out / "stats.csv");
+  std::string header, line;
+  std::getline(stats, header);
+  EXPECT_EQ(header.rfind("frame,time,particles,substeps,iterations,density_error_avg,density_error_max,"
+                         "kinetic_energy,wall_seconds", 0), 0u);
+  int rows = 0;
+  while (std::getline(stats, line)) ++rows;
+  EXPECT_EQ(rows, 4);
+  EXPECT_TRUE(fs::exists(out / "scene.json"));
+
+  openvdb::initialize();
+  for (int f = 0; f <= 3; ++f) {
+    openvdb::io::File file(framePath(out, "surface", f, "vdb").string());
+    file.open();
+    openvdb::GridBase::Ptr grid = file.readGrid("surface");
+    ASSERT_TRUE(grid);
+    EXPECT_EQ(grid->getGridClass(), openvdb::GRID_LEVEL_SET);
+    EXPECT_GT(grid->activeVoxelCount(), 0u);
+    file.close();
+    const TriangleMesh mesh = readMeshPly(framePath(out, "surface", f, "ply"));
+    EXPECT_GT(mesh.triangles.size(), 100u);
+
+    int width = 0, height = 0, channels = 0;
+    unsigned char* pixels = stbi_load(framePath(out, "frames", f, "png").c_str(), &width, &height, &channels, 3);
+    ASSERT_NE(pixels, nullptr);
+    EXPECT_EQ(width, 160);
+    EXPECT_EQ(height, 96);
+    stbi_image_free(pixels);
+  }
+  EXPECT_EQ(countVideoFrames(out / "tiny.mp4"), 4);
+}
+
+TEST(EndToEnd, BadSceneIsOneLineExitTwoAndWritesNothing) {
+  std::string text = kTinyScene;
+  text.replace(text.find("\"particle_spacing\": 0.03"), 24, "\"particle_spacing\": -1");
+  const fs::path scene = writeScene("bad.json", text);
+  const fs::path out = fs::path(testing::TempDir()) / "surge_e2e_bad";
+  fs::remove_all(out);
+  const Result r = runSurge("run '" + scene.string() + "' --out '" + out.string() + "'");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("bad.json: particle_spacing: -1 is out of range"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+
+  const Result unknown = runSurge("sim '" + scene.string() + "' --bogus");
+  EXPECT_EQ(unknown.status, 2);
+  const Result badSet = runSurge("sim '" + writeScene("ok.json", kTinyScene).string() + "' --set solver.substeps=x");
+  EXPECT_EQ(badSet.status, 2);
+  EXPECT_NE(badSet.err.find("--set: solver.substeps: expected an integer"), std::string::npos) << badSet.err;
+  const Result missing = runSurge("surface '" + out.string() + "'");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.err.find("scene.json"), std::string::npos) << missing.err;
+}
+
+TEST(EndToEnd, HelpForEveryCommand) {
+  for (const char* command : {"", "run", "sim", "surface", "render", "video", "keys"}) {
+    const Result r = runSurge(std::string(command) + " --help");
+    EXPECT_EQ(r.status, 0) << command;
+    EXPECT_NE(r.out.find("--help"), std::string::npos) << command;
+  }
+}
+
+}  // namespace
+}  // namespace surge

@@ -1,0 +1,75 @@
+#include "core/files.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include "core/errors.h"
+#include "core/parallel.h"
+
+namespace surge {
+namespace {
+
+TEST(Files, AtomicWriteLeavesOldFileWhenWriterFails) {
+  const fs::path dir = fs::path(testing::TempDir()) / "surge_files_test";
+  fs::remove_all(dir);
+  const fs::path path = dir / "a.txt";
+  writeFileAtomically(path, [](std::ostream& out) { out << "first"; });
+  EXPECT_THROW(writeFileAtomically(path,
+                                   [](std::ostream& out) {
+                                     out << "half";
+                                     throw std::runtime_error("disk full");
+                                   }),
+               std::runtime_error);
+  EXPECT_EQ(readTextFile(path), "first");
+  size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) files += entry.is_regular_file();
+  EXPECT_EQ(files, 1u);  // no temporary left behind
+}
+
+TEST(Files, FrameNamesAndListing) {
+  const fs::path dir = fs::path(testing::TempDir()) / "surge_frames_test";
+  fs::remove_all(dir);
+  EXPECT_EQ(framePath(dir, "particles", 7, "ply"), dir / "particles" / "frame_00007.ply");
+  for (int f : {3, 0, 12}) writeFileAtomically(framePath(dir, "particles", f, "ply"), [](std::ostream&) {});
+  writeFileAtomically(dir / "particles" / "frame_00004.ply.tmp123", [](std::ostream&) {});
+  EXPECT_EQ(listFrames(dir, "particles", "ply"), (std::vector<int>{0, 3, 12}));
+  EXPECT_TRUE(listFrames(dir, "nothing", "ply").empty());
+}
+
+TEST(Files, FrameRanges) {
+  EXPECT_EQ(FrameRange::parse("2:5").first, 2);
+  EXPECT_EQ(FrameRange::parse("2:5").last, 5);
+  EXPECT_TRUE(FrameRange::parse("4:").contains(100000));
+  EXPECT_FALSE(FrameRange::parse(":4").contains(5));
+  EXPECT_EQ(FrameRange::parse("7").last, 7);
+  EXPECT_THROW(FrameRange::parse("5:2"), InputError);
+  EXPECT_THROW(FrameRange::parse("a:b"), InputError);
+}
+
+TEST(Parallel, SumIsTheSameWhateverTheThreadCount) {
+  // Floating-point sums depend on their order; fixed chunks make the order independent of the threads.
+  auto sum = [] {
+    return parallelSum<double>(0, 1000003, [](size_t b, size_t e) {
+      double s = 0;
+      for (size_t i = b; i < e; ++i) s += 1.0 / double(i + 1);
+      return s;
+    });
+  };
+  double one, two;
+  {
+    ThreadLimit limit(1);
+    one = sum();
+  }
+  {
+    ThreadLimit limit(2);
+    two = sum();
+  }
+  EXPECT_EQ(one, two);
+  EXPECT_NEAR(one, std::log(1000003.0) + 0.5772156649, 1e-6);
+}
+
+}  // namespace
+}  // namespace surge

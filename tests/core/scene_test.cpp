@@ -1,0 +1,144 @@
+#include "core/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "core/errors.h"
+
+namespace surge {
+namespace {
+
+const char* kValid = R"({
+  "name": "tiny", "dimensions": 3,
+  "domain": {"min": [0, 0, 0], "max": [1, 1, 0.5]},
+  "particle_spacing": 0.05,
+  "fluids": [{"box": {"min": [0, 0, 0], "max": [0.4, 0.5, 0.5]}, "velocity": [1, 0, 0]}],
+  "solver": {"substeps": 2},
+  "output": {"fps": 24, "frames": 3}
+})";
+
+// Parses kValid with one key replaced (a JSON pointer such as "/solver/substeps") and expects an InputError
+// whose one-line message names the file and `key`.
+std::string errorFor(const std::string& pointer, const nlohmann::json& value, bool erase = false) {
+  nlohmann::json scene = nlohmann::json::parse(kValid);
+  if (erase)
+    scene.erase(pointer.substr(1));
+  else
+    scene[nlohmann::json::json_pointer(pointer)] = value;
+  try {
+    parseScene(scene.dump(), "scene.json");
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.exitStatus(), 2);
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_EQ(message.rfind("scene.json: ", 0), 0u) << message;
+    return message;
+  }
+  ADD_FAILURE() << "no error for " << pointer << " = " << value.dump();
+  return "";
+}
+
+TEST(Scene, ParsesContractKeysAndResolvesDerivedDefaults) {
+  const Scene scene = parseScene(kValid, "scene.json");
+  EXPECT_EQ(scene.name, "tiny");
+  EXPECT_EQ(scene.dimensions, 3);
+  EXPECT_DOUBLE_EQ(scene.domain.max.z(), 0.5);
+  ASSERT_EQ(scene.fluids.size(), 1u);
+  EXPECT_DOUBLE_EQ(scene.fluids[0].velocity.x(), 1.0);
+  EXPECT_EQ(scene.solver.substeps, 2);
+  EXPECT_EQ(scene.solver.iterations, 4);  // default
+  EXPECT_DOUBLE_EQ(scene.output.fps, 24);
+  EXPECT_DOUBLE_EQ(scene.solver.kernel_radius, 0.1);       // 2 x spacing
+  EXPECT_DOUBLE_EQ(scene.surface.particle_radius, 0.05);   // spacing
+  EXPECT_DOUBLE_EQ(scene.surface.voxel_size, 0.025);       // radius / 2
+  EXPECT_NE(scene.render.camera.position, scene.render.camera.look_at);  // the default camera is set
+  // 8 x 10 x 10 lattice cells of 0.05 in the 0.4 x 0.5 x 0.5 box.
+  EXPECT_EQ(scene.particleCount(), 800u);
+}
+
+TEST(Scene, OverridesApplyBeforeChecks) {
+  const Scene scene = parseScene(kValid, "scene.json",
+                                 {"solver.iterations=7", "fluids[0].velocity=[0,2,0]", "name=other"});
+  EXPECT_EQ(scene.solver.iterations, 7);
+  EXPECT_DOUBLE_EQ(scene.fluids[0].velocity.y(), 2.0);
+  EXPECT_EQ(scene.name, "other");
+  try {
+    parseScene(kValid, "scene.json", {"solver.iterations=0"});
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "--set: solver.iterations: 0 is out of range (>= 1, <= 10000)");
+  }
+  EXPECT_THROW(parseScene(kValid, "scene.json", {"solver.iteratons=3"}), InputError);
+  EXPECT_THROW(parseScene(kValid, "scene.json", {"novalue"}), InputError);
+  EXPECT_THROW(parseScene(kValid, "scene.json", {"fluids[3].velocity=[0,0,0]"}), InputError);
+}
+
+TEST(Scene, EveryBadInputIsOneLineNamingFileAndKey) {
+  EXPECT_NE(errorFor("/solver/typo", 1).find("solver.typo: unknown key"), std::string::npos);
+  EXPECT_NE(errorFor("/extra", 1).find("extra: unknown key"), std::string::npos);
+  EXPECT_NE(errorFor("/solver/substeps", "four").find("solver.substeps: expected an integer"), std::string::npos);
+  EXPECT_NE(errorFor("/solver/substeps", 2.5).find("solver.substeps: expected an integer"), std::string::npos);
+  EXPECT_NE(errorFor("/particle_spacing", nullptr, true).find("particle_spacing: missing required key"),
+            std::string::npos);
+  EXPECT_NE(errorFor("/particle_spacing", 0).find("particle_spacing: 0 is out of range (> 0)"), std::string::npos);
+  EXPECT_NE(errorFor("/particle_spacing", -0.1).find("particle_spacing"), std::string::npos);
+  EXPECT_NE(errorFor("/fluids/0/box/max", {0.4, 0.5, 0.7}).find("fluids[0].box: lies outside the domain"),
+            std::string::npos);
+  EXPECT_NE(errorFor("/fluids/0/box/max", {0.01, 0.5, 0.5}).find("fluids: the fluid boxes hold no particles"),
+            std::string::npos);
+  EXPECT_NE(errorFor("/fluids", nlohmann::json::array()).find("fluids: must not be empty"), std::string::npos);
+  // A lattice of 1e-5 m in a 0.4 x 0.5 x 0.5 box: 1e13 particles, far beyond this machine's memory.
+  EXPECT_NE(errorFor("/particle_spacing", 1e-5).find("particle_spacing: "), std::string::npos);
+  EXPECT_NE(errorFor("/particle_spacing", 1e-5).find("more than this machine's"), std::string::npos);
+  EXPECT_NE(errorFor("/domain/min", {0, 0}).find("domain.min: expected an array of 3 numbers"), std::string::npos);
+  EXPECT_NE(errorFor("/dimensions", 4).find("dimensions: 4 is out of range"), std::string::npos);
+  EXPECT_NE(errorFor("/solver/method", "sph").find("solver.method: 'sph' is not one of"), std::string::npos);
+  EXPECT_NE(errorFor("/domain/max", {1, 0, 0.5}).find("domain: min must be below max"), std::string::npos);
+  EXPECT_NE(errorFor("/solver/kernel_radius", 0.04).find("solver.kernel_radius: must exceed"), std::string::npos);
+}
+
+TEST(Scene, InvalidJsonNamesTheByte) {
+  try {
+    parseScene("{\"name\": \"x\",, }", "bad.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("bad.json: byte 14: invalid JSON", 0), 0u) << e.what();
+  }
+}
+
+TEST(Scene, TwoDimensionalVectorsHaveTwoComponents) {
+  const char* scene2d = R"({"name": "flat", "dimensions": 2, "domain": {"min": [0, 0], "max": [2, 1]},
+    "particle_spacing": 0.1, "fluids": [{"box": {"min": [0, 0], "max": [0.5, 0.5]}}], "gravity": [0, -9.81]})";
+  const Scene scene = parseScene(scene2d, "flat.json");
+  EXPECT_EQ(scene.particleCount(), 25u);
+  EXPECT_DOUBLE_EQ(scene.domain.max.z(), 0.0);
+  EXPECT_THROW(parseScene(scene2d, "flat.json", {"gravity=[0,-9.81,0]"}), InputError);
+}
+
+TEST(Scene, ResolvedSceneRoundTripsThroughJson) {
+  const Scene scene = parseScene(kValid, "scene.json", {"solver.iterations=3"});
+  const std::string text = sceneToJson(scene);
+  const Scene again = parseScene(text, "resolved.json");
+  EXPECT_EQ(sceneToJson(again), text);
+  EXPECT_EQ(again.solver.iterations, 3);
+}
+
+TEST(Scene, ShippedScenesLoad) {
+  for (const auto& entry : fs::directory_iterator(fs::path(SURGE_SOURCE_DIR) / "scenes")) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW(loadScene(entry.path()));
+  }
+}
+
+TEST(Scene, DocumentationListsEveryKey) {
+  // docs/scene-format.md embeds the table that `surge keys` prints; a key added to scene_fields.cpp without
+  // regenerating the document fails here.
+  const std::string doc = readTextFile(fs::path(SURGE_SOURCE_DIR) / "docs" / "scene-format.md");
+  const std::string table = sceneKeysMarkdown();
+  EXPECT_NE(doc.find(table), std::string::npos) << "regenerate the table with `surge keys`";
+}
+
+}  // namespace
+}  // namespace surge

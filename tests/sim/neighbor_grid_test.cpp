@@ -1,0 +1,78 @@
+#include "sim/neighbor_grid.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+namespace surge {
+namespace {
+
+// The brute-force twin: every pair closer than the radius, O(n^2).
+template <int Dim>
+std::vector<std::vector<uint32_t>> bruteForce(const std::vector<Vec<Dim>>& x, float radius) {
+  std::vector<std::vector<uint32_t>> lists(x.size());
+  for (size_t i = 0; i < x.size(); ++i)
+    for (size_t j = 0; j < x.size(); ++j)
+      if (i != j && (x[i] - x[j]).squaredNorm() < radius * radius) lists[i].push_back(uint32_t(j));
+  return lists;
+}
+
+template <int Dim>
+void expectSameAsBruteForce(std::vector<Vec<Dim>> x, const Vec<Dim>& lo, const Vec<Dim>& hi, float h) {
+  NeighborGrid<Dim> grid(lo, hi, h);
+  grid.sort(x);
+  std::vector<Vec<Dim>> sorted, scratch;
+  sorted = x;
+  gatherByOrder(grid.sortedOrder(), sorted, scratch);
+  // The order is a permutation that groups cells.
+  std::vector<uint32_t> order = grid.sortedOrder();
+  std::sort(order.begin(), order.end());
+  for (size_t i = 0; i < order.size(); ++i) ASSERT_EQ(order[i], i);
+
+  NeighborLists lists;
+  grid.findNeighbors(sorted, h, lists);
+  const auto expected = bruteForce<Dim>(sorted, h);
+  size_t pairs = 0;
+  for (size_t i = 0; i < sorted.size(); ++i) {
+    std::vector<uint32_t> got(lists.begin(i), lists.end(i));
+    ASSERT_EQ(got, expected[i]) << "particle " << i;
+    pairs += got.size();
+  }
+  EXPECT_GT(pairs, 0u);
+}
+
+TEST(NeighborGrid, MatchesBruteForceOnRandomPoints) {
+  std::mt19937 random(1);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::vector<Vec<3>> x(3000);
+  for (auto& p : x) p = Vec<3>(u(random), u(random) * 0.5f, u(random) * 0.7f);
+  expectSameAsBruteForce<3>(x, Vec<3>(0, 0, 0), Vec<3>(1, 0.5f, 0.7f), 0.07f);
+  std::vector<Vec<2>> y(2000);
+  for (auto& p : y) p = Vec<2>(u(random) * 2, u(random));
+  expectSameAsBruteForce<2>(y, Vec<2>(0, 0), Vec<2>(2, 1), 0.05f);
+}
+
+TEST(NeighborGrid, MatchesBruteForceWhenClusteredOrInOneCell) {
+  std::mt19937 random(2);
+  std::normal_distribution<float> n(0.0f, 0.02f);
+  std::vector<Vec<3>> clustered(2000);
+  for (size_t i = 0; i < clustered.size(); ++i) {
+    const Vec<3> centre = i % 2 ? Vec<3>(0.1f, 0.1f, 0.1f) : Vec<3>(0.8f, 0.05f, 0.5f);
+    clustered[i] = (centre + Vec<3>(n(random), n(random), n(random))).cwiseMax(0.0f).cwiseMin(1.0f);
+  }
+  expectSameAsBruteForce<3>(clustered, Vec<3>(0, 0, 0), Vec<3>(1, 1, 1), 0.05f);
+
+  std::uniform_real_distribution<float> u(0.0f, 0.04f);
+  std::vector<Vec<3>> oneCell(500);
+  for (auto& p : oneCell) p = Vec<3>(0.5f + u(random), 0.5f + u(random), 0.5f + u(random));
+  expectSameAsBruteForce<3>(oneCell, Vec<3>(0, 0, 0), Vec<3>(1, 1, 1), 0.05f);
+}
+
+TEST(NeighborGrid, PointsOnAndBeyondTheBorderAreClampedIntoCells) {
+  std::vector<Vec<2>> x = {{0, 0}, {1, 1}, {1.02f, 1.0f}, {-0.01f, 0.0f}, {0.5f, 0.5f}};
+  expectSameAsBruteForce<2>(x, Vec<2>(0, 0), Vec<2>(1, 1), 0.1f);
+}
+
+}  // namespace
+}  // namespace surge
