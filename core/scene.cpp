@@ -351,10 +351,10 @@ void validate(Scene& s, const std::string& where) {
   if (solver.kernel_radius == 0) solver.kernel_radius = 2 * spacing;
   if (solver.kernel_radius <= spacing)
     throw InputError(where, "solver.kernel_radius", "must exceed particle_spacing, or particles have no neighbours");
-  double cells = 1;
-  for (int k = 0; k < d; ++k) cells *= std::ceil((s.domain.max[k] - s.domain.min[k]) / solver.kernel_radius) + 2;
-  if (cells > double(1 << 28))
-    throw InputError(where, "domain", "spans " + formatNumber(cells) + " cells of the kernel radius; at most 2^28");
+  // The neighbour grid covers the particles' box only (sparsely if need be); cell coordinates must fit.
+  for (int k = 0; k < d; ++k)
+    if ((s.domain.max[k] - s.domain.min[k]) / solver.kernel_radius > double(1 << 20))
+      throw InputError(where, "domain", "spans more than 2^20 kernel radii along an axis");
 
   SurfaceSettings& surface = s.surface;
   if (surface.particle_radius == 0) surface.particle_radius = spacing;

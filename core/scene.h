@@ -31,7 +31,7 @@ struct SolverSettings {
   double relaxation_epsilon = 0.01;
   double max_density_error = 0;  // > 0: iterate until the average density error is under it
   double scorr_k = 0.1;          // artificial pressure (PBF eq. 13-14); 0 turns it off
-  double scorr_n = 4;
+  int scorr_n = 4;
   double scorr_delta_q = 0.2;  // as a fraction of the kernel radius
   double vorticity_epsilon = 0;  // vorticity confinement (eq. 15-16); 0 turns it off
   double xsph_c = 0.01;          // XSPH viscosity (eq. 17); 0 turns it off

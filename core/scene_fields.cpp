@@ -74,7 +74,7 @@ void visitScene(Scene& s, SceneVisitor& v) {
                       "`iterations` times; 0 runs exactly `iterations`"));
     v.real("scorr_k", s.solver.scorr_k,
            atLeast(0, "PBF eq. 13 artificial pressure k, in units of the rest lattice's lambda; 0 turns s_corr off"));
-    v.real("scorr_n", s.solver.scorr_n, positive("PBF eq. 13 exponent n"));
+    v.integer("scorr_n", s.solver.scorr_n, atLeast(1, "PBF eq. 13 exponent n", "", 16));
     {
       FieldInfo dq = positive("PBF eq. 13 delta q, as a fraction of the kernel radius (paper: 0.1 to 0.3)");
       dq.max = 1;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 
 namespace surge {
@@ -39,6 +40,20 @@ class Kernels {
     if (r >= h_) return 0.0f;
     const float d = h_ - r;
     return spiky_ * d * d * d;
+  }
+
+  // Both kernels of a pair at once from r2 = |p_i - p_j|^2, with one square root: W_poly6, and the factor g
+  // such that grad_{p_i} W_spiky(p_i - p_j, h) = g (p_i - p_j). Branch-free, for the solver's inner loops.
+  struct Pair {
+    float weight;
+    float gradientFactor;
+  };
+  Pair pair(float r2) const {
+    const float length = std::sqrt(r2);
+    const float d2 = std::max(h2_ - r2, 0.0f);
+    const float d = std::max(h_ - length, 0.0f);
+    const float factor = -3.0f * spiky_ * d * d / std::max(length, 1e-12f);
+    return {poly6_ * d2 * d2 * d2, length > 1e-12f ? factor : 0.0f};
   }
 
   // grad_{p_i} W_spiky(p_i - p_j, h) for r = p_i - p_j of length rLength. Zero at r = 0 (no direction).

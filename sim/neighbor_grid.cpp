@@ -1,101 +1,169 @@
 #include "sim/neighbor_grid.h"
 
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
 #include <cmath>
 
 #include "core/parallel.h"
 
 namespace surge {
+namespace {
+
+// A dense cell array is used while the box holds at most this many cells per particle.
+constexpr uint64_t kDenseCellsPerParticle = 8;
+constexpr uint64_t kDenseCellsMinimum = 1 << 16;
+
+}  // namespace
 
 template <int Dim>
 NeighborGrid<Dim>::NeighborGrid(const Vec<Dim>& domainMin, const Vec<Dim>& domainMax, float cellSize)
-    : origin_(domainMin), inverseCellSize_(1.0f / cellSize), cellSize_(cellSize) {
-  size_t cells = 1;
-  for (int k = 0; k < Dim; ++k) {
-    resolution_[k] = std::max(1, static_cast<int>(std::ceil((domainMax[k] - domainMin[k]) / cellSize)));
-    cells *= static_cast<size_t>(resolution_[k]);
-  }
-  cellStart_.assign(cells + 1, 0);
-}
+    : domainMin_(domainMin), domainMax_(domainMax), cellSize_(cellSize), inverseCellSize_(1.0f / cellSize) {}
 
 template <int Dim>
-Eigen::Matrix<int, Dim, 1> NeighborGrid<Dim>::cellCoordinates(const Vec<Dim>& p) const {
-  Eigen::Matrix<int, Dim, 1> c;
+typename NeighborGrid<Dim>::Cell NeighborGrid<Dim>::cellCoordinates(const Vec<Dim>& p) const {
+  Cell c;
   for (int k = 0; k < Dim; ++k) {
     const float x = (p[k] - origin_[k]) * inverseCellSize_;
     // NaN and far-away positions land in the border cells; the solver reports them separately.
-    c[k] = x >= 0.0f ? std::min(static_cast<int>(x), resolution_[k] - 1) : 0;
+    c[k] = x >= 0.0f ? std::min(static_cast<int64_t>(std::min(x, 4e18f)), resolution_[k] - 1) : 0;
   }
   return c;
 }
 
 template <int Dim>
-uint32_t NeighborGrid<Dim>::cellOf(const Vec<Dim>& p) const {
-  const auto c = cellCoordinates(p);
-  uint32_t index = 0;
-  for (int k = Dim - 1; k >= 0; --k) index = index * static_cast<uint32_t>(resolution_[k]) + c[k];
+uint64_t NeighborGrid<Dim>::linearIndex(const Cell& c) const {
+  uint64_t index = 0;
+  for (int k = Dim - 1; k >= 0; --k) index = index * static_cast<uint64_t>(resolution_[k]) + c[k];
   return index;
 }
 
 template <int Dim>
 void NeighborGrid<Dim>::sort(const std::vector<Vec<Dim>>& positions) {
   const size_t n = positions.size();
-  cellOfParticle_.resize(n);
+  // The box of the particles, clipped to the domain (NaN compares false and is skipped).
+  struct Bounds {
+    Vec<Dim> lo = Vec<Dim>::Constant(INFINITY), hi = Vec<Dim>::Constant(-INFINITY);
+    Bounds& operator+=(const Bounds& o) {
+      lo = lo.cwiseMin(o.lo);
+      hi = hi.cwiseMax(o.hi);
+      return *this;
+    }
+  };
+  Bounds box = parallelSum<Bounds>(0, n, [&](size_t b, size_t e) {
+    Bounds local;
+    for (size_t i = b; i < e; ++i)
+      for (int k = 0; k < Dim; ++k) {
+        if (positions[i][k] < local.lo[k]) local.lo[k] = positions[i][k];
+        if (positions[i][k] > local.hi[k]) local.hi[k] = positions[i][k];
+      }
+    return local;
+  });
+  uint64_t cells = 1;
+  for (int k = 0; k < Dim; ++k) {
+    const float lo = std::clamp(box.lo[k], domainMin_[k], domainMax_[k]);
+    const float hi = std::clamp(box.hi[k], lo, domainMax_[k]);
+    origin_[k] = n ? lo : domainMin_[k];
+    resolution_[k] = std::max<int64_t>(1, static_cast<int64_t>(std::floor((hi - lo) * inverseCellSize_)) + 1);
+    cells *= static_cast<uint64_t>(resolution_[k]);
+  }
+  cellCount_ = cells;
+  sparse_ = cells > std::max<uint64_t>(kDenseCellsMinimum, kDenseCellsPerParticle * n);
+
+  keyOfParticle_.resize(n);
   order_.resize(n);
   parallelFor(0, n, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) cellOfParticle_[i] = cellOf(positions[i]);
+    for (size_t i = b; i < e; ++i) keyOfParticle_[i] = linearIndex(cellCoordinates(positions[i]));
   });
-  // Counting sort: histogram, exclusive prefix sum, stable placement.
-  std::fill(cellStart_.begin(), cellStart_.end(), 0);
-  for (size_t i = 0; i < n; ++i) ++cellStart_[cellOfParticle_[i] + 1];
-  for (size_t c = 1; c < cellStart_.size(); ++c) cellStart_[c] += cellStart_[c - 1];
-  cursor_.assign(cellStart_.begin(), cellStart_.end() - 1);
-  for (size_t i = 0; i < n; ++i) order_[cursor_[cellOfParticle_[i]]++] = static_cast<uint32_t>(i);
+  if (!sparse_) {
+    // Counting sort: histogram, exclusive prefix sum, stable placement.
+    cellStart_.assign(cells + 1, 0);
+    for (size_t i = 0; i < n; ++i) ++cellStart_[keyOfParticle_[i] + 1];
+    for (size_t c = 1; c < cellStart_.size(); ++c) cellStart_[c] += cellStart_[c - 1];
+    cursor_.assign(cellStart_.begin(), cellStart_.end() - 1);
+    for (size_t i = 0; i < n; ++i) order_[cursor_[keyOfParticle_[i]]++] = static_cast<uint32_t>(i);
+    return;
+  }
+  // Sparse: sort (key, index) pairs, which are unique, so the result does not depend on the threads.
+  for (size_t i = 0; i < n; ++i) order_[i] = static_cast<uint32_t>(i);
+  tbb::parallel_sort(order_.begin(), order_.end(), [&](uint32_t a, uint32_t b) {
+    return keyOfParticle_[a] != keyOfParticle_[b] ? keyOfParticle_[a] < keyOfParticle_[b] : a < b;
+  });
+  cellKeys_.clear();
+  sparseStart_.clear();
+  for (size_t k = 0; k < n; ++k) {
+    const uint64_t key = keyOfParticle_[order_[k]];
+    if (cellKeys_.empty() || cellKeys_.back() != key) {
+      cellKeys_.push_back(key);
+      sparseStart_.push_back(static_cast<uint32_t>(k));
+    }
+  }
+  sparseStart_.push_back(static_cast<uint32_t>(n));
+}
+
+template <int Dim>
+void NeighborGrid<Dim>::slotsOfCells(uint64_t first, uint64_t last, uint32_t& begin, uint32_t& end) const {
+  if (!sparse_) {
+    begin = cellStart_[first];
+    end = cellStart_[last + 1];
+    return;
+  }
+  const auto lo = std::lower_bound(cellKeys_.begin(), cellKeys_.end(), first);
+  const auto hi = std::upper_bound(lo, cellKeys_.end(), last);
+  begin = sparseStart_[lo - cellKeys_.begin()];
+  end = sparseStart_[hi - cellKeys_.begin()];
 }
 
 template <int Dim>
 void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radius, NeighborLists& lists) const {
   const size_t n = x.size();
   const float r2 = radius * radius;
-  lists.offsets.resize(n + 1);
-  // Visits, for particle i, each run of sorted slots that may hold its neighbours: rows of three cells along x.
-  auto forEachCandidateRange = [&](size_t i, auto&& visit) {
-    const auto c = cellCoordinates(x[i]);
-    const int x0 = std::max(c[0] - 1, 0), x1 = std::min(c[0] + 1, resolution_[0] - 1);
-    const int y0 = std::max(c[1] - 1, 0), y1 = std::min(c[1] + 1, resolution_[1] - 1);
-    int z0 = 0, z1 = 0;
-    if constexpr (Dim == 3) {
-      z0 = std::max(c[2] - 1, 0);
-      z1 = std::min(c[2] + 1, resolution_[2] - 1);
-    }
-    for (int z = z0; z <= z1; ++z)
-      for (int y = y0; y <= y1; ++y) {
-        const size_t row = (static_cast<size_t>(z) * resolution_[1] + y) * resolution_[0];
-        visit(cellStart_[row + x0], cellStart_[row + x1 + 1]);
-      }
-  };
-  // Pass 1: count. Pass 2 (after a prefix sum): fill. Each particle writes only its own entries.
-  parallelFor(0, n, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      uint32_t count = 0;
-      forEachCandidateRange(i, [&](uint32_t s0, uint32_t s1) {
-        for (uint32_t j = s0; j < s1; ++j) count += (j != i) & ((x[i] - x[j]).squaredNorm() < r2);
-      });
-      lists.offsets[i + 1] = count;
-    }
-  });
-  lists.offsets[0] = 0;
-  for (size_t i = 0; i < n; ++i) lists.offsets[i + 1] += lists.offsets[i];
-  lists.indices.resize(lists.offsets[n]);
-  parallelFor(0, n, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      uint32_t* out = lists.indices.data() + lists.offsets[i];
-      forEachCandidateRange(i, [&](uint32_t s0, uint32_t s1) {
-        for (uint32_t j = s0; j < s1; ++j)
-          if (j != i && (x[i] - x[j]).squaredNorm() < r2) *out++ = j;
-      });
-    }
-  });
+  constexpr size_t kChunk = NeighborLists::kChunk;
+  const size_t chunks = (n + kChunk - 1) / kChunk;
+  lists.ends.resize(n);
+  lists.chunks.resize(chunks);
+  parallelFor(
+      0, chunks,
+      [&](size_t c0, size_t c1) {
+        for (size_t c = c0; c < c1; ++c) {
+          // The chunk's vector only grows (its size is its usable room); `used` counts what is filled.
+          std::vector<uint32_t>& chunk = lists.chunks[c];
+          size_t used = 0;
+          for (size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
+            const Vec<Dim> xi = x[i];
+            const Cell cell = cellCoordinates(xi);
+            Cell lo = cell, hi = cell;
+            for (int k = 0; k < Dim; ++k) {
+              lo[k] = std::max<int64_t>(cell[k] - 1, 0);
+              hi[k] = std::min<int64_t>(cell[k] + 1, resolution_[k] - 1);
+            }
+            constexpr int kRows = Dim == 3 ? 9 : 3;
+            uint32_t rowBegin[kRows], rowEnd[kRows];
+            int rows = 0;
+            size_t candidates = 0;
+            const int64_t z0 = Dim == 3 ? lo[Dim - 1] : 0, z1 = Dim == 3 ? hi[Dim - 1] : 0;
+            for (int64_t z = z0; z <= z1; ++z)
+              for (int64_t y = lo[1]; y <= hi[1]; ++y, ++rows) {
+                Cell first = lo, last = hi;
+                first[1] = last[1] = y;
+                if constexpr (Dim == 3) first[2] = last[2] = z;
+                slotsOfCells(linearIndex(first), linearIndex(last), rowBegin[rows], rowEnd[rows]);
+                candidates += rowEnd[rows] - rowBegin[rows];
+              }
+            // Room for every candidate, then keep those in range: no capacity check per neighbour.
+            if (chunk.size() < used + candidates) chunk.resize(2 * (used + candidates));
+            uint32_t* out = chunk.data() + used;
+            for (int row = 0; row < rows; ++row)
+              for (uint32_t j = rowBegin[row]; j < rowEnd[row]; ++j) {
+                *out = j;
+                out += ((xi - x[j]).squaredNorm() < r2) & (j != i);
+              }
+            used = static_cast<size_t>(out - chunk.data());
+            lists.ends[i] = static_cast<uint32_t>(used);
+          }
+        }
+      },
+      1);
 }
 
 template <typename T>

@@ -1,9 +1,12 @@
 // Neighbour search on a uniform grid of cells the size of the kernel radius (after Green's "Particle
-// Simulation using CUDA" and SPlisHSPlasH's CompactNSearch): particles are sorted into cells with a counting
-// sort in linear cell order (x fastest), the caller reorders its particle arrays by that order so neighbours
-// sit close in memory, and neighbour lists are built into flat arrays. A cell's particles are contiguous, and so
-// are the particles of a row of three cells along x, so a query reads 3 ranges in 2D and 9 in 3D. Piling
-// every particle into a few cells costs nothing extra beyond the neighbour pairs themselves.
+// Simulation using CUDA" and SPlisHSPlasH's CompactNSearch). Each sort() lays the grid over the particles'
+// bounding box (clipped to the domain), so a small body of fluid in a large tank costs no more than in a small
+// one. Particles are sorted into cells in linear cell order (x fastest): with a counting sort over a dense array
+// of cells when the box holds at most a few cells per particle, else (fluid spread thinly over a large domain)
+// by sorting 64-bit cell keys and keeping only the occupied cells. The caller reorders its particle arrays by
+// the sorted order so neighbours sit close in memory, and neighbour lists are built into flat arrays. A row of
+// three cells along x is one contiguous run of particles, so a query reads 3 runs in 2D and 9 in 3D; piling
+// every particle into a few cells costs nothing beyond the neighbour pairs themselves.
 #pragma once
 
 #include <cstdint>
@@ -13,20 +16,30 @@
 
 namespace surge {
 
-// Neighbour lists in flat arrays: the neighbours of particle i are indices[offsets[i] .. offsets[i + 1]).
+// Neighbour lists in flat arrays, one per fixed chunk of kChunk particles (so that chunks fill their arrays in
+// parallel with no second pass and no copy): the neighbours of particle i are a run of chunk i / kChunk's array
+// that ends at ends[i] and starts where particle i - 1's ends (or at 0 for the first particle of a chunk). The
+// arrays keep their capacity from one rebuild to the next, so a step allocates nothing once warmed up.
 struct NeighborLists {
-  std::vector<uint32_t> offsets;
-  std::vector<uint32_t> indices;
+  static constexpr size_t kChunk = 2048;
+  std::vector<uint32_t> ends;
+  std::vector<std::vector<uint32_t>> chunks;
 
-  size_t count(size_t i) const { return offsets[i + 1] - offsets[i]; }
-  const uint32_t* begin(size_t i) const { return indices.data() + offsets[i]; }
-  const uint32_t* end(size_t i) const { return indices.data() + offsets[i + 1]; }
+  size_t size() const { return ends.size(); }
+  const uint32_t* begin(size_t i) const { return chunks[i / kChunk].data() + (i % kChunk ? ends[i - 1] : 0); }
+  const uint32_t* end(size_t i) const { return chunks[i / kChunk].data() + ends[i]; }
+  size_t count(size_t i) const { return end(i) - begin(i); }
+  size_t total() const {
+    size_t sum = 0;
+    for (size_t i = kChunk - 1; i < ends.size(); i += kChunk) sum += ends[i];
+    return ends.empty() ? 0 : sum + (ends.size() % kChunk ? ends.back() : 0);
+  }
 };
 
 template <int Dim>
 class NeighborGrid {
  public:
-  // Cells cover [domainMin, domainMax] (positions outside are clamped into the border cells).
+  // Cells of `cellSize`; positions outside [domainMin, domainMax] are clamped into the border cells.
   NeighborGrid(const Vec<Dim>& domainMin, const Vec<Dim>& domainMax, float cellSize);
 
   // Sorts the particles into cells. Afterwards sortedOrder()[k] is the input index of the k-th particle in cell
@@ -34,27 +47,36 @@ class NeighborGrid {
   void sort(const std::vector<Vec<Dim>>& positions);
   const std::vector<uint32_t>& sortedOrder() const { return order_; }
 
-  // For positions already in the order of the last sort(): lists, for each particle, every other particle
-  // closer than `radius` (which must not exceed the cell size), in increasing index order.
+  // For positions in the order of the last sort(): lists, for each particle, every other particle closer than
+  // `radius` (at most the cell size), in increasing index order.
   void findNeighbors(const std::vector<Vec<Dim>>& sortedPositions, float radius, NeighborLists& lists) const;
 
-  size_t cellCount() const { return cellStart_.size() - 1; }
+  // Cells of the last sort's box, and whether it used the sparse (sorted keys) path.
+  uint64_t cellCount() const { return cellCount_; }
+  bool sparse() const { return sparse_; }
 
  private:
-  uint32_t cellOf(const Vec<Dim>& p) const;
-  Eigen::Matrix<int, Dim, 1> cellCoordinates(const Vec<Dim>& p) const;
+  using Cell = Eigen::Matrix<int64_t, Dim, 1>;
+  Cell cellCoordinates(const Vec<Dim>& p) const;
+  uint64_t linearIndex(const Cell& c) const;
+  // The sorted slots [begin, end) of the cells with linear indices [first, last].
+  void slotsOfCells(uint64_t first, uint64_t last, uint32_t& begin, uint32_t& end) const;
 
+  Vec<Dim> domainMin_, domainMax_;
+  float cellSize_, inverseCellSize_;
   Vec<Dim> origin_;
-  float inverseCellSize_;
-  float cellSize_;
-  Eigen::Matrix<int, Dim, 1> resolution_;
-  std::vector<uint32_t> cellStart_;  // per cell, the first sorted slot; one extra entry at the end
-  std::vector<uint32_t> cellOfParticle_;
+  Cell resolution_;
+  uint64_t cellCount_ = 0;
+  bool sparse_ = false;
+  std::vector<uint32_t> cellStart_;    // dense: per cell, its first slot (plus one entry at the end)
+  std::vector<uint64_t> cellKeys_;     // sparse: the occupied cells' linear indices, ascending
+  std::vector<uint32_t> sparseStart_;  // sparse: per occupied cell, its first slot (plus one at the end)
+  std::vector<uint64_t> keyOfParticle_;
   std::vector<uint32_t> order_;
-  std::vector<uint32_t> cursor_;  // counting-sort scratch
+  std::vector<uint32_t> cursor_;
 };
 
-// Applies a permutation: out[k] = in[order[k]], in parallel. Used to reorder every particle channel.
+// Applies a permutation: values[k] = old values[order[k]], in parallel. Used to reorder every particle channel.
 template <typename T>
 void gatherByOrder(const std::vector<uint32_t>& order, std::vector<T>& values, std::vector<T>& scratch);
 

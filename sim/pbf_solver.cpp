@@ -10,6 +10,13 @@ namespace surge {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+// x^n for a small integer n by repeated multiplication (std::pow costs more than the rest of the pair).
+inline float integerPower(float x, int n) {
+  float result = 1.0f;
+  for (int k = 0; k < n; ++k) result *= x;
+  return result;
+}
+
 double millisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
@@ -58,10 +65,12 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene)
   // denominator. epsilon is a fraction of it, s_corr is measured in lambda's units 1 / that sum.
   latticeGradientSum_ = static_cast<float>(massOverRho_ * massOverRho_ * gradientSquaredSum);
   epsilon_ = static_cast<float>(s.relaxation_epsilon) * latticeGradientSum_;
+  coincidentLength_ = 1e-4f * kernels_.radius();
   scorrK_ = static_cast<float>(s.scorr_k);
-  scorrN_ = static_cast<float>(s.scorr_n);
+  scorrN_ = s.scorr_n;
   const float dq = static_cast<float>(s.scorr_delta_q * s.kernel_radius);
   scorrInvWdq_ = 1.0f / kernels_.poly6(dq * dq);
+  scorrAtRest_ = integerPower(kernels_.poly6(spacing * spacing) * scorrInvWdq_, scorrN_);
   vorticityEpsilon_ = static_cast<float>(s.vorticity_epsilon);
   xsphC_ = static_cast<float>(s.xsph_c);
   iterations_ = s.iterations;
@@ -69,6 +78,7 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene)
   gravity_ = toVec<Dim>(scene.gravity);
   domainMin_ = toVec<Dim>(scene.domain.min);
   domainMax_ = toVec<Dim>(scene.domain.max);
+  // Collision response keeps particle centres a particle radius inside the walls.
   const float particleRadius = 0.5f * spacing;
   wallMin_ = domainMin_ + VecD::Constant(particleRadius);
   wallMax_ = domainMax_ - VecD::Constant(particleRadius);
@@ -106,7 +116,7 @@ void PbfSolver<Dim>::addWallTerms(const VecD& p, float& weight, VecD& gradient) 
     for (int side = 0; side < 2; ++side) {
       const float d = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
       const float u = std::max(d, 0.0f) * wallTableScale_;
-      if (u >= kWallTableSize) continue;
+      if (!(u < kWallTableSize)) continue;  // also skips NaN
       const int t = static_cast<int>(u);
       const float f = u - t;
       weight += (1 - f) * wallWeight_[t] + f * wallWeight_[t + 1];
@@ -209,17 +219,20 @@ double PbfSolver<Dim>::computeLambdas() {
   return parallelSum<double>(0, size(), [&](size_t b, size_t e) {
     double errorSum = 0;
     for (size_t i = b; i < e; ++i) {
+      const VecD pi = p_[i];
       float weight = selfWeight;
-      VecD gradientI = VecD::Zero();
-      float gradientSquaredSum = 0;
+      VecD gradientSum = VecD::Zero();  // sum_j grad W, times m / rho_0 below
+      float gradientSquaredSum = 0;     // sum_j |grad W|^2, times (m / rho_0)^2 below
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
-        const VecD r = p_[i] - p_[*j];
-        const float length = r.norm();
-        weight += kernels_.poly6(length * length);
-        const VecD gradientJ = massOverRho_ * kernels_.spikyGradient(r, length);
-        gradientI += gradientJ;
-        gradientSquaredSum += gradientJ.squaredNorm();
+        const VecD r = pairOffset(i, *j, pi - p_[*j]);
+        const float r2 = r.squaredNorm();
+        const auto k = kernels_.pair(r2);
+        weight += k.weight;
+        gradientSum += k.gradientFactor * r;
+        gradientSquaredSum += k.gradientFactor * k.gradientFactor * r2;
       }
+      VecD gradientI = massOverRho_ * gradientSum;
+      gradientSquaredSum *= massOverRho_ * massOverRho_;
       VecD wallGradient = VecD::Zero();
       addWallTerms(p_[i], weight, wallGradient);
       gradientI += massOverRho_ * wallGradient;
@@ -236,21 +249,29 @@ double PbfSolver<Dim>::computeLambdas() {
 //   delta p_i = (m / rho_0) sum_j (lambda_i + lambda_j + s_corr) grad W_spiky(p_i - p_j, h),
 //   s_corr = -k (W_poly6(p_i - p_j) / W_poly6(delta q))^n, in lambda's units (divided by the rest lattice's
 //   sum of squared gradients) so that k means the same at every resolution.
-// Then collision response (line 17) and x*_i += delta p_i (line 18), as two passes to stay Jacobi.
+// Two changes to eq. 13, both because our density constraint is one-sided where the paper's is two-sided (the
+// paper's s_corr counters the tension of its two-sided constraint; ours has none):
+//  - the value s_corr has at the rest spacing is subtracted (and s_corr kept <= 0), so it pushes only pairs
+//    closer than the rest lattice: unshifted, it swells a resting column by several percent;
+//  - it acts only on pairs whose density constraints are both inactive (lambda_i = lambda_j = 0), that is in
+//    spray and thin sheets where nothing else keeps particles apart; in compressed fluid the constraint already
+//    does, and s_corr there adds pressure that the position update turns into kinetic energy.
 template <int Dim>
 void PbfSolver<Dim>::applyPositionCorrections() {
   const bool scorr = scorrK_ > 0;
   const float scorrScale = scorrK_ / latticeGradientSum_;
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
+      const VecD pi = p_[i];
+      const float lambdaI = lambda_[i];
       VecD delta = VecD::Zero();
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
-        const VecD r = p_[i] - p_[*j];
-        const float length = r.norm();
-        float coefficient = lambda_[i] + lambda_[*j];
-        if (scorr)
-          coefficient -= scorrScale * std::pow(kernels_.poly6(length * length) * scorrInvWdq_, scorrN_);
-        delta += coefficient * kernels_.spikyGradient(r, length);
+        const VecD r = pairOffset(i, *j, pi - p_[*j]);
+        const auto k = kernels_.pair(r.squaredNorm());
+        float coefficient = lambdaI + lambda_[*j];
+        if (scorr && coefficient == 0.0f)
+          coefficient = -scorrScale * std::max(integerPower(k.weight * scorrInvWdq_, scorrN_) - scorrAtRest_, 0.0f);
+        delta += (coefficient * k.gradientFactor) * r;
       }
       // The walls do not move and carry no constraint of their own: only lambda_i acts along their gradient.
       float unusedWeight = 0;
@@ -338,19 +359,51 @@ void PbfSolver<Dim>::applyXsphViscosity() {
   times_.viscosity += millisecondsSince(start);
 }
 
+// Two particles on the same point (the walls project every particle that overshoots a corner onto the same
+// corner) have no kernel gradient between them, so no constraint could ever part them, and their summed density
+// would push their neighbours ever harder. Such a pair is given a tiny offset along a direction that depends on
+// the pair only and flips with its order (so momentum is still conserved).
+template <int Dim>
+typename PbfSolver<Dim>::VecD PbfSolver<Dim>::pairOffset(size_t i, size_t j, const VecD& r) const {
+  if (r.squaredNorm() > coincidentLength_ * coincidentLength_) return r;
+  const uint32_t lo = static_cast<uint32_t>(std::min(i, j)), hi = static_cast<uint32_t>(std::max(i, j));
+  uint32_t hash = lo * 0x9E3779B1u ^ (hi + 0x7F4A7C15u) * 0x85EBCA77u;
+  VecD direction;
+  for (int k = 0; k < Dim; ++k) {
+    hash ^= hash >> 15;
+    hash *= 0x2C1B3C6Du;
+    direction[k] = static_cast<float>(hash & 0xFFFF) / 32768.0f - 1.0f;
+  }
+  direction[0] += 1e-3f;  // never the zero vector
+  return (i < j ? coincidentLength_ : -coincidentLength_) * direction.normalized();
+}
+
+// Collision response with the tank: positions are projected back inside. NaN stays NaN (comparisons with NaN
+// are false), so a diverged particle is reported instead of being hidden at a wall.
 template <int Dim>
 void PbfSolver<Dim>::clampToWalls(VecD& p) const {
-  p = p.cwiseMax(wallMin_).cwiseMin(wallMax_);
+  for (int k = 0; k < Dim; ++k) p[k] = p[k] < wallMin_[k] ? wallMin_[k] : (p[k] > wallMax_[k] ? wallMax_[k] : p[k]);
 }
 
 template <int Dim>
 long PbfSolver<Dim>::firstBadParticle() const {
-  for (size_t i = 0; i < size(); ++i) {
-    const bool finite = x_[i].allFinite() && v_[i].allFinite();
-    const bool inside = (x_[i].array() >= domainMin_.array()).all() && (x_[i].array() <= domainMax_.array()).all();
-    if (!finite || !inside) return static_cast<long>(i);
-  }
-  return -1;
+  struct First {
+    long index = -1;
+    First& operator+=(const First& o) {
+      if (index < 0 || (o.index >= 0 && o.index < index)) index = o.index;
+      return *this;
+    }
+  };
+  return parallelSum<First>(0, size(), [&](size_t b, size_t e) {
+           First first;
+           for (size_t i = b; i < e && first.index < 0; ++i) {
+             const bool finite = x_[i].allFinite() && v_[i].allFinite();
+             const bool inside =
+                 (x_[i].array() >= domainMin_.array()).all() && (x_[i].array() <= domainMax_.array()).all();
+             if (!finite || !inside) first.index = static_cast<long>(i);
+           }
+           return first;
+         }).index;
 }
 
 // Density error of DESIGN.md at the current positions, with the neighbour lists of the last step.
@@ -365,7 +418,7 @@ FluidMeasures PbfSolver<Dim>::measure() {
       return *this;
     }
   };
-  if (neighbors_.offsets.size() != size() + 1) {
+  if (neighbors_.size() != size()) {
     p_ = x_;  // before the first step: neighbours of the current positions
     findNeighbors();
   }

@@ -64,6 +64,7 @@ class PbfSolver {
   void applyVorticityConfinement(float dt);
   void applyXsphViscosity();
   void clampToWalls(VecD& p) const;
+  VecD pairOffset(size_t i, size_t j, const VecD& r) const;
   // Adds the walls' share of eq. 2 and eq. 8 for a particle at p: to the kernel weight sum and to
   // sum_j grad W (both before the factor m or m / rho_0).
   void addWallTerms(const VecD& p, float& weight, VecD& gradient) const;
@@ -72,7 +73,9 @@ class PbfSolver {
   // Parameters, fixed at construction.
   Kernels<Dim> kernels_;
   float restDensity_, mass_, massOverRho_, epsilon_, latticeGradientSum_;
-  float scorrK_, scorrN_, scorrInvWdq_;
+  float scorrK_, scorrInvWdq_, scorrAtRest_;
+  int scorrN_;
+  float coincidentLength_;
   float vorticityEpsilon_, xsphC_;
   int iterations_;
   double maxDensityError_;

@@ -7,32 +7,13 @@
 #include <fstream>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
-#include <sys/wait.h>
 
 #include "core/files.h"
 #include "core/ply.h"
+#include "tests/apps/run_surge.h"
 
 namespace surge {
 namespace {
-
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
-
-// Runs surge with `arguments` (a shell-quoted string), capturing stdout and stderr.
-Result runSurge(const std::string& arguments) {
-  const fs::path dir = fs::path(testing::TempDir()) / "surge_e2e_io";
-  fs::create_directories(dir);
-  const std::string command = std::string(SURGE_BINARY) + " " + arguments + " >" + (dir / "out").string() +
-                              " 2>" + (dir / "err").string();
-  Result result;
-  const int raw = std::system(command.c_str());
-  result.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  result.out = readTextFile(dir / "out");
-  result.err = readTextFile(dir / "err");
-  return result;
-}
 
 int countVideoFrames(const fs::path& mp4) {
   const std::string command = "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
@@ -55,17 +36,11 @@ const char* kTinyScene = R"({
   "render": {"width": 160, "height": 96, "samples": 1}
 })";
 
-fs::path writeScene(const std::string& name, const std::string& text) {
-  const fs::path path = fs::path(testing::TempDir()) / name;
-  std::ofstream(path) << text;
-  return path;
-}
-
 TEST(EndToEnd, RunMakesEveryStagesFiles) {
-  const fs::path scene = writeScene("tiny.json", kTinyScene);
+  const fs::path scene = writeTestScene("tiny.json", kTinyScene);
   const fs::path out = fs::path(testing::TempDir()) / "surge_e2e_tiny";
   fs::remove_all(out);
-  const Result r = runSurge("run '" + scene.string() + "' --out '" + out.string() + "' --quiet");
+  const SurgeResult r = runSurge("run '" + scene.string() + "' --out '" + out.string() + "' --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(r.out.empty()) << "--quiet prints nothing: " << r.out;
 
@@ -116,28 +91,28 @@ TEST(EndToEnd, RunMakesEveryStagesFiles) {
 TEST(EndToEnd, BadSceneIsOneLineExitTwoAndWritesNothing) {
   std::string text = kTinyScene;
   text.replace(text.find("\"particle_spacing\": 0.03"), 24, "\"particle_spacing\": -1");
-  const fs::path scene = writeScene("bad.json", text);
+  const fs::path scene = writeTestScene("bad.json", text);
   const fs::path out = fs::path(testing::TempDir()) / "surge_e2e_bad";
   fs::remove_all(out);
-  const Result r = runSurge("run '" + scene.string() + "' --out '" + out.string() + "'");
+  const SurgeResult r = runSurge("run '" + scene.string() + "' --out '" + out.string() + "'");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("bad.json: particle_spacing: -1 is out of range"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(out));
 
-  const Result unknown = runSurge("sim '" + scene.string() + "' --bogus");
+  const SurgeResult unknown = runSurge("sim '" + scene.string() + "' --bogus");
   EXPECT_EQ(unknown.status, 2);
-  const Result badSet = runSurge("sim '" + writeScene("ok.json", kTinyScene).string() + "' --set solver.substeps=x");
+  const SurgeResult badSet = runSurge("sim '" + writeTestScene("ok.json", kTinyScene).string() + "' --set solver.substeps=x");
   EXPECT_EQ(badSet.status, 2);
   EXPECT_NE(badSet.err.find("--set: solver.substeps: expected an integer"), std::string::npos) << badSet.err;
-  const Result missing = runSurge("surface '" + out.string() + "'");
+  const SurgeResult missing = runSurge("surface '" + out.string() + "'");
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.err.find("scene.json"), std::string::npos) << missing.err;
 }
 
 TEST(EndToEnd, HelpForEveryCommand) {
   for (const char* command : {"", "run", "sim", "surface", "render", "video", "keys"}) {
-    const Result r = runSurge(std::string(command) + " --help");
+    const SurgeResult r = runSurge(std::string(command) + " --help");
     EXPECT_EQ(r.status, 0) << command;
     EXPECT_NE(r.out.find("--help"), std::string::npos) << command;
   }

@@ -76,3 +76,37 @@ TEST(NeighborGrid, PointsOnAndBeyondTheBorderAreClampedIntoCells) {
 
 }  // namespace
 }  // namespace surge
+
+namespace surge {
+namespace {
+
+TEST(NeighborGrid, SparsePathInALargeDomainMatchesBruteForce) {
+  // 2000 particles in two small clumps at opposite corners of a 100 m tank with 5 cm cells: the box of the
+  // particles spans 8e9 cells, so the grid keeps only the occupied ones.
+  std::mt19937 random(4);
+  std::uniform_real_distribution<float> u(0.0f, 0.3f);
+  std::vector<Vec<3>> x(2000);
+  for (size_t i = 0; i < x.size(); ++i) {
+    const Vec<3> corner = i % 2 ? Vec<3>(1, 1, 1) : Vec<3>(98, 97, 96);
+    x[i] = corner + Vec<3>(u(random), u(random), u(random));
+  }
+  NeighborGrid<3> grid(Vec<3>(0, 0, 0), Vec<3>(100, 100, 100), 0.05f);
+  grid.sort(x);
+  EXPECT_TRUE(grid.sparse());
+  expectSameAsBruteForce<3>(x, Vec<3>(0, 0, 0), Vec<3>(100, 100, 100), 0.05f);
+}
+
+TEST(NeighborGrid, DenseGridCoversOnlyTheParticlesBox) {
+  // A clump in the corner of a large tank costs cells for the clump only.
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> u(0.0f, 0.5f);
+  std::vector<Vec<3>> x(5000);
+  for (auto& p : x) p = Vec<3>(u(random), u(random), u(random));
+  NeighborGrid<3> grid(Vec<3>(0, 0, 0), Vec<3>(50, 50, 50), 0.05f);
+  grid.sort(x);
+  EXPECT_FALSE(grid.sparse());
+  EXPECT_LE(grid.cellCount(), 11u * 11u * 11u);
+}
+
+}  // namespace
+}  // namespace surge
