@@ -46,6 +46,11 @@ struct SurfaceSettings {
   double particle_radius = 0;  // 0 in the file: particle_spacing (resolved on load)
   double voxel_size = 0;       // 0 in the file: particle_radius / 2 (resolved on load)
   double adaptivity = 0;
+  std::string method = "spheres";      // spheres, smooth_spheres or anisotropic (surface/surfacer.h)
+  int smoothing_steps = 2;             // mean-curvature steps of tools::LevelSetFilter
+  int write_velocity = 0;              // 1: the VDB also holds a vector grid "v"
+  int write_points = 0;                // 1: the VDB also holds a PointDataGrid "points" with attribute "v"
+  int write_obj = 0;                   // 1: an OBJ mesh beside the PLY
 };
 
 struct CameraSettings {
@@ -57,9 +62,18 @@ struct CameraSettings {
 struct RenderSettings {
   int width = 960;
   int height = 540;
-  int samples = 4;  // per pixel
+  int samples = 8;  // per pixel (path tracer; the demo's 120 frames take about 2.5 minutes on 2 cores)
+  int max_depth = 8;  // path segments before a path stops (Russian roulette may stop it sooner)
+  std::string quality = "standard";  // standard: the numbers above; preview and final scale them (renderer.h)
   CameraSettings camera;
   Eigen::Vector3d water_color = Eigen::Vector3d(0.15, 0.45, 0.8);
+  double absorption_distance = 0.25;  // white light takes water_color after this far through water (m)
+  Eigen::Vector3d sun_direction = Eigen::Vector3d(-0.4, 0.85, -0.25);  // towards the sun
+  Eigen::Vector3d sun_color = Eigen::Vector3d(1.0, 0.95, 0.87);
+  double sun_radius = 1.2;  // angular radius in degrees (soft shadows)
+  Eigen::Vector3d sky_zenith = Eigen::Vector3d(0.32, 0.5, 0.82);
+  Eigen::Vector3d sky_horizon = Eigen::Vector3d(0.78, 0.84, 0.9);
+  double exposure = 1.0;
 };
 
 struct Scene {

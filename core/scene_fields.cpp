@@ -97,11 +97,26 @@ void visitScene(Scene& s, SceneVisitor& v) {
                       "below which OpenVDB would drop particles)",
                    "m"));
     v.real("adaptivity", s.surface.adaptivity, atLeast(0, "volumeToMesh adaptivity, 0 (uniform) to 1", "", 1));
+    v.choice("method", s.surface.method, {"spheres", "smooth_spheres", "anisotropic"},
+             info("level set: spheres (union of particle spheres), smooth_spheres (Zhu & Bridson 2005 blend), "
+                  "anisotropic (Yu & Turk 2013 ellipsoids from neighbour PCA); see docs/performance.md"));
+    v.integer("smoothing_steps", s.surface.smoothing_steps,
+              atLeast(0, "mean-curvature smoothing steps of the level set (LevelSetFilter)", "", 100));
+    v.integer("write_velocity", s.surface.write_velocity,
+              atLeast(0, "1: the VDB also holds a velocity grid `v` (particle velocities, kernel-averaged)", "", 1));
+    v.integer("write_points", s.surface.write_points,
+              atLeast(0, "1: the VDB also holds the particles as a PointDataGrid `points` with a `v` attribute", "", 1));
+    v.integer("write_obj", s.surface.write_obj, atLeast(0, "1: write an OBJ mesh beside each PLY mesh", "", 1));
   });
   v.group("render", info("the renderer"), [&] {
     v.integer("width", s.render.width, atLeast(16, "image width", "pixels", 16384));
     v.integer("height", s.render.height, atLeast(16, "image height", "pixels", 16384));
     v.integer("samples", s.render.samples, atLeast(1, "samples per pixel", "", 65536));
+    v.integer("max_depth", s.render.max_depth,
+              atLeast(1, "path tracer: most surfaces a path meets (Russian roulette may stop it sooner)", "", 1000));
+    v.choice("quality", s.render.quality, {"standard", "preview", "final"},
+             info("standard: width, height, samples and max_depth as given; preview: half the resolution, 4 "
+                  "samples, depth 4; final: at least 720 pixels high, 64 samples, depth 12"));
     v.group("camera", info("the camera; leave position equal to look_at to frame the domain"), [&] {
       v.vector("position", s.render.camera.position, info("eye position", "m"), true);
       v.vector("look_at", s.render.camera.look_at, info("point at the image centre", "m"), true);
@@ -109,7 +124,19 @@ void visitScene(Scene& s, SceneVisitor& v) {
       fov.max = 170;
       v.real("fov", s.render.camera.fov, fov);
     });
-    v.vector("water_color", s.render.water_color, atLeast(0, "linear RGB colour of the water", "", 1), true);
+    v.vector("water_color", s.render.water_color,
+             atLeast(0.001, "linear RGB colour white light takes through absorption_distance of water", "", 1), true);
+    v.real("absorption_distance", s.render.absorption_distance,
+           positive("distance over which water absorbs white light to water_color (Beer-Lambert)", "m"));
+    v.vector("sun_direction", s.render.sun_direction, info("direction towards the sun (any length but 0)"), true);
+    v.vector("sun_color", s.render.sun_color, atLeast(0, "linear RGB irradiance of the sun", "", 1000), true);
+    FieldInfo sunRadius = positive("angular radius of the sun; larger gives softer shadows", "degrees");
+    sunRadius.max = 30;
+    v.real("sun_radius", s.render.sun_radius, sunRadius);
+    v.vector("sky_zenith", s.render.sky_zenith, atLeast(0, "linear RGB radiance of the sky overhead", "", 1000), true);
+    v.vector("sky_horizon", s.render.sky_horizon,
+             atLeast(0, "linear RGB radiance of the sky at the horizon", "", 1000), true);
+    v.real("exposure", s.render.exposure, positive("scale on linear light before the tone map"));
   });
 }
 

@@ -51,6 +51,15 @@ class PinholeCamera {
     return true;
   }
 
+  // The camera's frame, for rasterisers that need it as a matrix: unit forward, right and up vectors, and the
+  // tangents of half the field of view across and up.
+  const Eigen::Vector3f& position() const { return position_; }
+  const Eigen::Vector3f& forward() const { return forward_; }
+  const Eigen::Vector3f& right() const { return right_; }
+  const Eigen::Vector3f& up() const { return up_; }
+  float tanHalfWidth() const { return tanHalfWidth_; }
+  float tanHalfHeight() const { return tanHalfHeight_; }
+
  private:
   Eigen::Vector3f position_, forward_, right_, up_;
   float width_, height_, tanHalfWidth_ = 1, tanHalfHeight_ = 1;

@@ -1,6 +1,10 @@
-// The render stage: ray-traces a water mesh in its tank (Embree 3) into an sRGB image, and turns a run's
-// surface/frame_NNNNN.ply meshes into frames/frame_NNNNN.png. Embree stays behind this header.
+// The render stage: path-traces a water mesh in its tank (Embree 3, render/shading.h) into an sRGB image, or
+// rasterises it (or the particles) with OSMesa for a quick look (render/rasterizer.h), and turns a run's
+// surface/frame_NNNNN.ply meshes into frames/frame_NNNNN.png. Embree and GL stay behind these headers.
 #pragma once
+
+#include <cstdint>
+#include <string>
 
 #include "core/files.h"
 #include "core/ply.h"
@@ -10,15 +14,39 @@
 
 namespace surge {
 
-// Renders the water mesh with the scene's tank, ground, sky and camera at scene.render.width x height and
-// scene.render.samples jittered samples a pixel. `frame` seeds the per-pixel random numbers, which depend
-// only on (frame, pixel, sample): the image is the same bytes whatever the thread count. An empty mesh
-// renders the empty tank. Stops early with surge::Interrupted if the user asks to stop.
-Image renderMesh(const TriangleMesh& water, const Scene& scene, int frame);
+struct Shading;
 
-// For every dir/surface/frame_NNNNN.ply whose frame is in `range`, writes dir/frames/frame_NNNNN.png.
-// Progress: start("render", frames), advance() per frame. Throws InputError(dir, ...) if there are no surface
-// frames (or none in range), Interrupted between frames and tiles when asked to stop.
-void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress);
+// The settings a `quality` preset stands for: "standard" keeps width, height, samples and max_depth;
+// "preview" halves the resolution (at least 16 pixels) and uses 4 samples and depth 4; "final" scales the
+// resolution up to at least 720 pixels high (1280x720 for the default 16:9) with at least 64 samples and
+// depth 12. The camera is the scene's either way (its framing depends only on the aspect ratio, which the
+// presets keep).
+RenderSettings resolvedRenderSettings(const RenderSettings& settings);
+
+// What a render cost, for the benchmark.
+struct RenderStats {
+  uint64_t rays = 0;  // path segments and shadow rays cast
+};
+
+// Path-traces the water mesh with the scene's tank, ground, sky and camera at the resolved resolution and
+// samples (resolvedRenderSettings). `frame` seeds the per-pixel random numbers, which depend only on (frame,
+// pixel, sample): the image is the same bytes whatever the thread count. An empty mesh renders the empty
+// tank. Stops early with surge::Interrupted if the user asks to stop; InputError for a bad mesh or settings.
+Image renderMesh(const TriangleMesh& water, const Scene& scene, int frame, RenderStats* stats = nullptr);
+// The same with the look given explicitly instead of Shading::fromScene(scene) (tests use a white furnace).
+Image renderMeshWith(const TriangleMesh& water, const Scene& scene, int frame, const Shading& shading,
+                     RenderStats* stats = nullptr);
+
+struct RenderOptions {
+  std::string renderer = "embree";  // "embree" (path tracer) or "gl" (OSMesa rasteriser)
+  bool particles = false;           // gl: draw particles/frame_NNNNN.ply as spheres instead of the surface
+};
+
+// For every frame in `range` writes dir/frames/frame_NNNNN.png: from dir/surface/frame_NNNNN.ply, or with the
+// gl renderer from dir/particles/frame_NNNNN.ply when options.particles is set or there are no surface frames
+// at all. Progress: start("render", frames), advance() per frame. Throws InputError(dir, ...) if there is
+// nothing to render (or nothing in range) or the renderer is unknown, Interrupted when asked to stop.
+void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress,
+                  const RenderOptions& options = {});
 
 }  // namespace surge

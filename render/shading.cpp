@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/errors.h"
+
 namespace surge {
 
 namespace {
@@ -11,19 +13,39 @@ namespace {
 using Vec3 = Eigen::Vector3f;
 
 constexpr float kFar = std::numeric_limits<float>::infinity();
-
-// Water reflects 2 % of light at normal incidence (refractive index 1.33); Schlick's approximation after
-// that.
-float fresnelWater(float cosine) {
-  const float m = 1.0f - std::clamp(cosine, 0.0f, 1.0f);
-  return 0.02f + 0.98f * m * m * m * m * m;
-}
+constexpr float kPi = 3.14159265f;
+// Russian roulette starts after this many segments: the first bounces carry most of the image and are never
+// cut.
+constexpr int kRouletteAfter = 3;
+// Shadow rays cross at most this many water surfaces (a splash seen edge-on); beyond, the sun counts as
+// blocked.
+constexpr int kMaxShadowCrossings = 16;
+// A single sample is clamped to this radiance (about 30 times white paper). Only specular chains that find
+// the sun's disc (radiance ~2000) after a refraction or two reach it; unclamped, one such sample among 16
+// paints an isolated white pixel ("firefly"). The clamp biases those glints a little dark and leaves
+// everything else, including the white furnace (radiance 1), untouched.
+constexpr float kSampleClamp = 32.0f;
 
 Vec3 reflect(const Vec3& direction, const Vec3& normal) {
   return direction - 2.0f * direction.dot(normal) * normal;
 }
 
-// Two unit vectors orthogonal to n (Duff et al., "Building an orthonormal basis, revisited").
+// Unpolarised Fresnel reflectance of a smooth dielectric for light arriving at cosine cosI (> 0) with
+// eta = n_incident / n_transmitted; cosT receives the cosine of the refracted ray. Returns 1 for total
+// internal reflection (PBRT 3rd ed., eq. 8.4-8.5).
+float fresnelDielectric(float cosI, float eta, float& cosT) {
+  const float sin2T = eta * eta * std::max(0.0f, 1.0f - cosI * cosI);
+  if (sin2T >= 1.0f) {
+    cosT = 0;
+    return 1.0f;
+  }
+  cosT = std::sqrt(1.0f - sin2T);
+  const float rs = (eta * cosI - cosT) / (eta * cosI + cosT);
+  const float rp = (eta * cosT - cosI) / (eta * cosT + cosI);
+  return 0.5f * (rs * rs + rp * rp);
+}
+
+// Two unit vectors orthogonal to n (Duff et al., "Building an orthonormal basis, revisited", 2017).
 void orthonormalBasis(const Vec3& n, Vec3& a, Vec3& b) {
   const float sign = std::copysign(1.0f, n.z());
   const float p = -1.0f / (sign + n.z());
@@ -32,120 +54,105 @@ void orthonormalBasis(const Vec3& n, Vec3& a, Vec3& b) {
   b = Vec3(q, sign + n.y() * n.y() * p, -n.y());
 }
 
-// A direction towards a random point of the sun's disc, so shadow edges soften by the sun's size.
+// A cosine-distributed direction around n (Malley's method): pdf cos / pi, so a Lambertian bounce weighs
+// exactly its albedo.
+Vec3 sampleCosine(const Vec3& n, SampleRandom& random) {
+  float u = 0, v = 0;
+  random.next2(u, v);
+  const float r = std::sqrt(u), phi = 2.0f * kPi * v;
+  Vec3 a, b;
+  orthonormalBasis(n, a, b);
+  const float x = r * std::cos(phi), y = r * std::sin(phi);
+  return (x * a + y * b + std::sqrt(std::max(0.0f, 1.0f - x * x - y * y)) * n).normalized();
+}
+
+// A direction uniformly distributed over the sun's disc (a cone of the sun's angular radius).
 Vec3 sampleSun(const Shading& shading, SampleRandom& random) {
   Vec3 a, b;
   orthonormalBasis(shading.sunDirection, a, b);
-  const float cosTheta = 1.0f - random.next() * (1.0f - shading.sunCosRadius);
+  float u = 0, v = 0;
+  random.next2(u, v);
+  const float cosTheta = 1.0f - u * (1.0f - shading.sunCosRadius);
   const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - cosTheta * cosTheta));
-  const float phi = 6.2831853f * random.next();
+  const float phi = 2.0f * kPi * v;
   return (cosTheta * shading.sunDirection + sinTheta * (std::cos(phi) * a + std::sin(phi) * b)).normalized();
 }
 
-// Direct sun and sky light reaching a point with the given normal (irradiance over pi, times the sun colour).
-struct Light {
-  Vec3 sunDirection;
-  float sunVisible = 0;  // 1 if the sampled sun direction is unblocked
-  Vec3 direct = Vec3::Zero();
-  Vec3 ambient = Vec3::Zero();
-};
-
-Light lightAt(const RayScene& world, const Shading& shading, const Hit& hit, SampleRandom& random) {
-  Light light;
-  light.sunDirection = sampleSun(shading, random);
-  const float cosine = hit.normal.dot(light.sunDirection);
-  // No test against the geometric normal: the shadow ray from the lifted leave point decides, which keeps
-  // the terminator of smooth-shaded water smooth instead of following the facets.
-  if (cosine > 0 && !world.occluded(hit.leavePoint, light.sunDirection, kFar)) light.sunVisible = 1;
-  light.direct = light.sunVisible * std::max(cosine, 0.0f) * shading.sunColor;
-  // Sky light: full from the zenith on an upward face, about half on a wall, a little on an overhang.
-  const Vec3 skyAverage = 0.5f * (shading.skyZenith + shading.skyHorizon);
-  light.ambient = shading.skyAmbient * (0.6f + 0.4f * hit.normal.y()) * skyAverage;
-  return light;
+Vec3 absorb(const Shading& shading, float distance) {
+  return (-distance * shading.waterAbsorption).array().exp().matrix();
 }
 
-Vec3 groundAlbedo(const Shading& shading, const Hit& hit, float distance) {
-  const Vec3& p = hit.point;
-  const bool insideTank = p.x() >= shading.tankMin.x() && p.x() <= shading.tankMax.x() &&
-                          p.z() >= shading.tankMin.z() && p.z() <= shading.tankMax.z();
-  const long cx = std::lround(std::floor((p.x() - shading.tankMin.x()) / shading.checkerSize));
-  const long cz = std::lround(std::floor((p.z() - shading.tankMin.z()) / shading.checkerSize));
-  // The checker fades out with distance, where its squares would shrink below a pixel and shimmer.
-  const float contrast = 0.05f * std::exp(-distance / (0.25f * shading.hazeDistance));
-  const float checker = ((cx + cz) & 1) ? contrast : -contrast;
-  const float base = insideTank ? 0.72f : 0.5f;
-  return Vec3(base + checker, base + checker, base * 0.97f + checker);
-}
-
-Vec3 shadeDiffuse(const RayScene& world, const Shading& shading, const Hit& hit, const Vec3& albedo,
-                  SampleRandom& random) {
-  const Light light = lightAt(world, shading, hit, random);
-  return albedo.cwiseProduct(light.direct + light.ambient);
-}
-
-Vec3 trace(const RayScene& world, const Shading& shading, const Ray& ray, SampleRandom& random, int depth);
-
-// Water for now: a coloured body lit by sun and sky, a Fresnel-weighted mirror reflection and a sun
-// highlight.
-Vec3 shadeWater(const RayScene& world, const Shading& shading, const Ray& ray, const Hit& hit,
-                SampleRandom& random, int depth) {
-  const Vec3& n = hit.normal;
-  const Light light = lightAt(world, shading, hit, random);
-  const float fresnel = fresnelWater(-ray.direction.dot(n));
-
-  // Smooth normals can send a reflection below the true surface: lift it just above the face instead.
-  Vec3 mirror = reflect(ray.direction, n);
-  const float below = mirror.dot(hit.geometricNormal);
-  if (below < 0.01f) mirror = (mirror + (0.01f - below) * hit.geometricNormal).normalized();
-  Vec3 reflected;
-  if (depth < 1) {
-    Ray bounce;
-    bounce.origin = hit.leavePoint;
-    bounce.direction = mirror;
-    reflected = trace(world, shading, bounce, random, depth + 1);
-  } else {
-    reflected = skyRadiance(shading, mirror);
+// How much sunlight arrives along a straight shadow ray: 0 if the ground blocks it, else the product of the
+// Fresnel transmissions and the absorption of the water it crosses.
+Vec3 sunTransmittance(const RayScene& world, const Shading& shading, const Vec3& origin,
+                      const Vec3& direction, bool inside, PathStats& stats) {
+  Vec3 transmittance = Vec3::Ones();
+  Ray ray;
+  ray.origin = origin;
+  ray.direction = direction;
+  for (int crossing = 0; crossing < kMaxShadowCrossings; ++crossing) {
+    Hit hit;
+    ++stats.rays;
+    if (!world.intersect(ray, kFar, hit, true)) return transmittance;
+    if (hit.kind != SurfaceKind::Water) return Vec3::Zero();
+    if (inside) transmittance = transmittance.cwiseProduct(absorb(shading, hit.distance));
+    float cosT = 0;
+    const float cosI = std::abs(direction.dot(hit.geometricNormal));
+    transmittance *= 1.0f - fresnelDielectric(cosI, inside ? shading.ior : 1.0f / shading.ior, cosT);
+    inside = !inside;
+    ray.origin = hit.passPoint;
   }
-
-  const Vec3 body = shading.waterColor.cwiseProduct(0.6f * light.direct + light.ambient);
-  const Vec3 halfway = (light.sunDirection - ray.direction).normalized();
-  const float highlight = light.sunVisible * std::pow(std::max(n.dot(halfway), 0.0f), 800.0f);
-  return (1.0f - fresnel) * body + fresnel * reflected + 4.0f * highlight * shading.sunColor;
+  return Vec3::Zero();
 }
 
-Vec3 trace(const RayScene& world, const Shading& shading, const Ray& ray, SampleRandom& random, int depth) {
-  Hit hit;
-  if (!world.intersect(ray, kFar, hit)) return skyRadiance(shading, ray.direction);
-  switch (hit.kind) {
-    case SurfaceKind::Water:
-      return shadeWater(world, shading, ray, hit, random, depth);
-    case SurfaceKind::TankEdge:
-      return shadeDiffuse(world, shading, hit, Vec3(0.05f, 0.05f, 0.055f), random);
-    case SurfaceKind::Ground:
-      break;
+// The specular event at a water surface: the Fresnel reflectance and both directions (refracted is unset
+// under total internal reflection, fresnel = 1). False if, with a smooth shading normal, either direction
+// lies on the wrong side of the true face; the caller then uses the geometric normal.
+bool waterEvent(const Shading& shading, const Vec3& normal, const Hit& hit, bool inside, const Vec3& d,
+                float& fresnel, Vec3& reflected, Vec3& refracted) {
+  const float cosI = -d.dot(normal);
+  if (cosI <= 0) return false;
+  const float eta = inside ? shading.ior : 1.0f / shading.ior;
+  float cosT = 0;
+  fresnel = fresnelDielectric(cosI, eta, cosT);
+  reflected = reflect(d, normal);
+  if (reflected.dot(hit.geometricNormal) <= 0) return false;
+  if (fresnel < 1.0f) {
+    refracted = (eta * d + (eta * cosI - cosT) * normal).normalized();  // Snell's law, PBRT eq. 8.8
+    if (refracted.dot(hit.geometricNormal) >= 0) return false;
   }
-  const Vec3 lit = shadeDiffuse(world, shading, hit, groundAlbedo(shading, hit, hit.distance), random);
-  const float haze = 1.0f - std::exp(-hit.distance / shading.hazeDistance);
-  return (1.0f - haze) * lit + haze * shading.skyHorizon;
+  return true;
+}
+
+Vec3 sunDisc(const Shading& shading, const Vec3& direction) {
+  if (direction.dot(shading.sunDirection) < shading.sunCosRadius) return Vec3::Zero();
+  // Radiance that gives irradiance pi * sunColor over the disc's solid angle 2 pi (1 - cos r).
+  return shading.sunColor / (2.0f * (1.0f - shading.sunCosRadius));
 }
 
 }  // namespace
 
 Shading Shading::fromScene(const Scene& scene) {
+  const RenderSettings& r = scene.render;
   Shading s;
-  s.sunDirection = Vec3(-0.4f, 0.85f, -0.25f).normalized();  // high, from the back left: highlights on waves
-  s.sunColor = Vec3(1.0f, 0.95f, 0.87f);
-  s.sunCosRadius = std::cos(0.02f);  // about twice the real sun, for visibly soft shadow edges
-  s.skyZenith = Vec3(0.32f, 0.5f, 0.82f);
-  s.skyHorizon = Vec3(0.78f, 0.84f, 0.9f);
-  s.belowHorizon = Vec3(0.42f, 0.42f, 0.44f);
-  s.skyAmbient = 0.5f;
-  s.waterColor = scene.render.water_color.cast<float>();
+  if (r.sun_direction.norm() < 1e-9) throw InputError(scene.name, "render.sun_direction", "must not be zero");
+  s.sunDirection = r.sun_direction.cast<float>().normalized();
+  s.sunColor = r.sun_color.cast<float>();
+  s.sunCosRadius = float(std::cos(r.sun_radius * M_PI / 180.0));
+  s.skyZenith = r.sky_zenith.cast<float>();
+  s.skyHorizon = r.sky_horizon.cast<float>();
+  s.belowHorizon = 0.5f * s.skyHorizon;
+  // Beer-Lambert: exp(-sigma d) = colour at d = absorption_distance, so sigma = -ln(colour) / d.
+  for (int k = 0; k < 3; ++k)
+    s.waterAbsorption[k] =
+        float(-std::log(std::clamp(r.water_color[k], 1e-3, 1.0)) / std::max(r.absorption_distance, 1e-6));
   s.tankMin = scene.domain.min.cast<float>();
   s.tankMax = scene.domain.max.cast<float>();
   const float size = std::max((s.tankMax - s.tankMin).maxCoeff(), 1e-3f);
   s.checkerSize = size / 8.0f;
   s.hazeDistance = 12.0f * size;
+  s.maxDepth = r.max_depth;
+  s.exposure = float(r.exposure);
   return s;
 }
 
@@ -158,11 +165,137 @@ Vec3 skyRadiance(const Shading& shading, const Vec3& direction) {
   const float t = std::pow(up, 0.6f);
   const Vec3 gradient = (1.0f - t) * shading.skyHorizon + t * shading.skyZenith;
   const float glow = std::pow(std::max(direction.dot(shading.sunDirection), 0.0f), 64.0f);
-  return gradient + 0.25f * glow * shading.sunColor;
+  return gradient + shading.sunGlow * glow * shading.sunColor;
 }
 
-Vec3 traceRadiance(const RayScene& world, const Shading& shading, const Ray& ray, SampleRandom& random) {
-  return trace(world, shading, ray, random, 0);
+Vec3 groundAlbedoAt(const Shading& shading, const Vec3& p, float distance) {
+  const bool insideTank = p.x() >= shading.tankMin.x() && p.x() <= shading.tankMax.x() &&
+                          p.z() >= shading.tankMin.z() && p.z() <= shading.tankMax.z();
+  const long cx = std::lround(std::floor((p.x() - shading.tankMin.x()) / shading.checkerSize));
+  const long cz = std::lround(std::floor((p.z() - shading.tankMin.z()) / shading.checkerSize));
+  // The checker fades out with distance, where its squares would shrink below a pixel and shimmer.
+  const float contrast = shading.checkerContrast * std::exp(-distance / (0.25f * shading.hazeDistance));
+  const float checker = ((cx + cz) & 1) ? contrast : -contrast;
+  const float base = insideTank ? shading.floorAlbedo : shading.groundAlbedo;
+  return Vec3(base + checker, base + checker, 0.97f * base + checker);
+}
+
+namespace {
+
+// Where a path is: its next ray, whether it is in water, whether it has been specular so far (then the sun's
+// disc is seen, not sampled), how far the camera ray and its specular continuations went (checker fade), its
+// segment count and its throughput.
+struct PathState {
+  Ray ray;
+  bool inside = false;  // the camera is assumed to be in air
+  bool specular = true;
+  float travelled = 0;
+  int depth = 0;
+  Vec3 throughput = Vec3::Ones();
+};
+
+// The light a path gathers from its state on. With `split`, the first water surface met sends both a
+// reflected and a refracted path, weighted F and 1 - F, instead of choosing one: the camera's view of the
+// water then shows its reflection without the speckle of a random choice at 2-10 % odds. Later water
+// surfaces choose at random (with the Fresnel probability, which keeps the estimate unbiased).
+Vec3 gather(const RayScene& world, const Shading& shading, PathState path, SampleRandom& random,
+            PathStats& stats, bool split) {
+  Vec3 radiance = Vec3::Zero();
+  Vec3& throughput = path.throughput;
+  Ray& ray = path.ray;
+  for (; path.depth < shading.maxDepth; ++path.depth) {
+    Hit hit;
+    ++stats.rays;
+    if (!world.intersect(ray, kFar, hit)) {
+      radiance += throughput.cwiseProduct(skyRadiance(shading, ray.direction) +
+                                          (path.specular ? sunDisc(shading, ray.direction) : Vec3::Zero()));
+      break;
+    }
+    if (path.inside) throughput = throughput.cwiseProduct(absorb(shading, hit.distance));
+    if (path.specular) path.travelled += hit.distance;
+    if (path.specular && hit.kind == SurfaceKind::Ground) {
+      // Haze over the ground seen from the camera, growing with the square of the distance: nothing on the
+      // tank, the horizon colour far away, so the ground plane's edge melts into the sky.
+      const float r = path.travelled / shading.hazeDistance, haze = 1.0f - std::exp(-r * r);
+      radiance += haze * throughput.cwiseProduct(shading.skyHorizon);
+      throughput *= 1.0f - haze;
+    }
+
+    if (hit.kind == SurfaceKind::Water) {
+      float fresnel = 1;
+      Vec3 reflected, refracted;
+      Hit face = hit;
+      if (!waterEvent(shading, hit.normal, hit, path.inside, ray.direction, fresnel, reflected, refracted)) {
+        face.normal = hit.geometricNormal;  // the smooth normal disagrees with the face here
+        if (!waterEvent(shading, face.normal, face, path.inside, ray.direction, fresnel, reflected,
+                        refracted))
+          break;
+      }
+      if (split && fresnel < 1.0f) {
+        PathState mirror = path, through = path;
+        ++mirror.depth;
+        ++through.depth;
+        mirror.ray.origin = hit.leavePoint;
+        mirror.ray.direction = reflected;
+        mirror.throughput *= fresnel;
+        through.ray.origin = hit.passPoint;
+        through.ray.direction = refracted;
+        through.inside = !path.inside;
+        through.throughput *= 1.0f - fresnel;
+        return radiance + gather(world, shading, mirror, random, stats, false) +
+               gather(world, shading, through, random, stats, false);
+      }
+      if (fresnel >= 1.0f || random.next() < fresnel) {
+        ray.origin = hit.leavePoint;
+        ray.direction = reflected;
+      } else {
+        ray.origin = hit.passPoint;
+        ray.direction = refracted;
+        path.inside = !path.inside;
+      }
+    } else {
+      const Vec3 albedo = hit.kind == SurfaceKind::Ground ? groundAlbedoAt(shading, hit.point, path.travelled)
+                                                          : Vec3::Constant(shading.tankAlbedo);
+      // Next-event estimation of the sun: (albedo / pi) L_sun cos / pdf, with pdf = 1 / solid angle of the
+      // disc, which is albedo * sunColor * cos.
+      const Vec3 toSun = sampleSun(shading, random);
+      const float cosine = hit.normal.dot(toSun);
+      if (cosine > 0) {
+        const Vec3 sun = sunTransmittance(world, shading, hit.leavePoint, toSun, path.inside, stats);
+        radiance += cosine * throughput.cwiseProduct(albedo).cwiseProduct(sun).cwiseProduct(shading.sunColor);
+      }
+      throughput = throughput.cwiseProduct(albedo);
+      ray.origin = hit.leavePoint;
+      ray.direction = sampleCosine(hit.normal, random);
+      path.specular = false;
+      split = false;  // only the camera's direct view of the water splits
+    }
+
+    if (path.depth + 1 >= kRouletteAfter) {
+      const float survive = std::min(throughput.maxCoeff(), 0.95f);
+      if (survive <= 0 || random.next() >= survive) break;
+      throughput /= survive;
+    }
+  }
+  return radiance;
+}
+
+}  // namespace
+
+Vec3 traceRadiance(const RayScene& world, const Shading& shading, const Ray& cameraRay, SampleRandom& random,
+                   PathStats* stats) {
+  PathStats local;
+  PathState path;
+  path.ray = cameraRay;
+  const Vec3 radiance = gather(world, shading, path, random, local, true);
+  if (stats) stats->rays += local.rays;
+  const float peak = radiance.maxCoeff();
+  return peak > kSampleClamp ? Vec3(radiance * (kSampleClamp / peak)) : radiance;
+}
+
+float toneMap(float linear, float exposure) {
+  const float x = std::max(0.0f, linear * exposure);
+  return std::clamp((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
 }
 
 }  // namespace surge

@@ -1,6 +1,19 @@
-// How a Surge render looks: the sky, the sun, and the materials of water, ground and tank. traceRadiance() is
-// the one function that answers "what light comes back along this camera ray"; the renderer only averages it
-// over samples, so a path tracer can replace it without touching cameras, tiles or files.
+// How a Surge render looks: the sky, the sun, and the materials of water, ground and tank, and the path
+// tracer that carries light between them. traceRadiance() is the one function that answers "what light comes
+// back along this camera ray"; the renderer only averages it over samples and tone-maps the result.
+//
+// The light transport, in short (Pharr, Jakob & Humphreys, "Physically Based Rendering", 3rd ed., ch. 14):
+// - water is a smooth dielectric of index 1.333: at each hit the path reflects with the exact Fresnel
+//   probability F and refracts otherwise (total internal reflection when Snell has no solution), so the
+//   choice itself carries the Fresnel weight and no energy is created or lost at the interface;
+// - inside the water the throughput falls as exp(-sigma d) (Beer-Lambert), sigma per colour channel;
+// - the ground and the tank's edges are Lambertian: the sun is sampled explicitly on its disc (soft shadows)
+//   and the path continues in a cosine-distributed direction; the sky is reached by that continuation;
+// - shadow rays pass through water, weighted by its Fresnel transmission and absorption, so the tank floor
+//   under water is lit as the average of the caustics it would show (a path tracer cannot find a point sun
+//   through a refracting surface);
+// - after three segments Russian roulette stops a path with probability 1 - min(max throughput, 0.95) and
+//   reweights the survivors, so the estimate stays unbiased up to max_depth.
 #pragma once
 
 #include <Eigen/Core>
@@ -13,25 +26,45 @@ namespace surge {
 
 struct Shading {
   Eigen::Vector3f sunDirection;  // unit, towards the sun
-  Eigen::Vector3f sunColor;      // radiance scale of direct sun light on a surface facing it
-  float sunCosRadius = 0;        // cosine of the sun's angular radius (soft shadows)
+  Eigen::Vector3f sunColor;      // irradiance on a surface facing the sun, over pi (radiance of white paper)
+  float sunCosRadius = 0;        // cosine of the sun's angular radius
   Eigen::Vector3f skyZenith, skyHorizon, belowHorizon;
-  float skyAmbient = 0;  // sky light on an upward-facing surface, as a fraction of the sky's colour
-  Eigen::Vector3f waterColor;
-  // The ground: a subtle checkerboard of `checkerSize` squares aligned to the tank, a lighter tank floor
-  // inside the tank's footprint, and distance haze towards the horizon colour.
+  float sunGlow = 0.25f;  // the sky's brightening around the sun, as a fraction of sunColor
+  // Water: index of refraction and Beer-Lambert absorption per metre.
+  float ior = 1.333f;
+  Eigen::Vector3f waterAbsorption = Eigen::Vector3f::Zero();
+  // The ground: a checkerboard of `checkerSize` squares aligned to the tank, of albedo floorAlbedo inside the
+  // tank's footprint and groundAlbedo outside, each square +-checkerContrast; distance haze towards the
+  // horizon colour.
   float checkerSize = 1;
+  float floorAlbedo = 0.62f, groundAlbedo = 0.42f, checkerContrast = 0.12f;
   Eigen::Vector3f tankMin, tankMax;
   float hazeDistance = 100;
+  float tankAlbedo = 0.04f;
+  int maxDepth = 8;
+  float exposure = 1;
 
+  // Throws InputError(scene.name, "render.sun_direction", ...) for a zero sun direction.
   static Shading fromScene(const Scene& scene);
 };
 
-// The sky seen in a unit direction: a gradient from the horizon to the zenith with a glow around the sun.
+// The sky seen in a unit direction: a gradient from the horizon to the zenith with a glow around the sun,
+// without the sun's disc (which the tracer adds where a specular path sees it).
 Eigen::Vector3f skyRadiance(const Shading& shading, const Eigen::Vector3f& direction);
 
-// Linear RGB light arriving along `ray` (camera rays and the reflections they spawn).
+// The albedo of the ground at a point (checkerboard, tank floor), fading the checker with distance.
+Eigen::Vector3f groundAlbedoAt(const Shading& shading, const Eigen::Vector3f& point, float distance);
+
+// What a path costs: rays cast (path segments plus shadow rays), for the benchmark's rays per second.
+struct PathStats {
+  uint64_t rays = 0;
+};
+
+// Linear RGB light arriving along a camera ray: one path-traced sample.
 Eigen::Vector3f traceRadiance(const RayScene& world, const Shading& shading, const Ray& ray,
-                              SampleRandom& random);
+                              SampleRandom& random, PathStats* stats = nullptr);
+
+// Linear light to display: exposure, then the ACES filmic curve fitted by Narkowicz (2015), in [0, 1].
+float toneMap(float linear, float exposure);
 
 }  // namespace surge

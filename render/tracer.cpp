@@ -161,7 +161,7 @@ RayScene::RayScene(const RayDevice& device, const TriangleMesh& water, const Sce
 
 RayScene::~RayScene() = default;
 
-bool RayScene::intersect(const Ray& ray, float maxDistance, Hit& hit) const {
+bool RayScene::intersect(const Ray& ray, float maxDistance, Hit& hit, bool shadowRay) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit query;
@@ -174,7 +174,7 @@ bool RayScene::intersect(const Ray& ray, float maxDistance, Hit& hit) const {
   query.ray.tnear = 0.0f;
   query.ray.tfar = maxDistance;
   query.ray.time = 0.0f;
-  query.ray.mask = kSeen;
+  query.ray.mask = shadowRay ? kCastsShadow : kSeen;
   query.ray.id = 0;
   query.ray.flags = 0;
   query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -193,6 +193,7 @@ bool RayScene::intersect(const Ray& ray, float maxDistance, Hit& hit) const {
   hit.geometricNormal = ng;
   hit.normal = ng;
   hit.leavePoint = hit.point + offset_ * ng;
+  hit.passPoint = hit.point - offset_ * ng;
   if (hit.kind == SurfaceKind::Water && impl_->smooth) {
     const auto& tri = impl_->water->triangles[query.hit.primID];
     const auto& n = impl_->water->normals;

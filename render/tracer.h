@@ -38,6 +38,8 @@ struct Hit {
   Eigen::Vector3f normal = Eigen::Vector3f::UnitY();           // shading normal, unit, same side as above
   // Where shadow and reflection rays start: the point lifted off the surface on the ray's side.
   Eigen::Vector3f leavePoint = Eigen::Vector3f::Zero();
+  // Where refracted rays start: the point pushed just through the surface.
+  Eigen::Vector3f passPoint = Eigen::Vector3f::Zero();
 };
 
 class RayScene {
@@ -49,8 +51,9 @@ class RayScene {
   RayScene(const RayScene&) = delete;
   RayScene& operator=(const RayScene&) = delete;
 
-  // The nearest hit along the ray closer than maxDistance, if any.
-  bool intersect(const Ray& ray, float maxDistance, Hit& hit) const;
+  // The nearest hit along the ray closer than maxDistance, if any; a shadow ray sees only what casts
+  // shadows (not the tank's edges).
+  bool intersect(const Ray& ray, float maxDistance, Hit& hit, bool shadowRay = false) const;
   // True if anything that casts shadows (not the tank's edges) lies on the segment from origin along the unit
   // direction up to maxDistance.
   bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float maxDistance) const;

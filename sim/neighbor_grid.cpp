@@ -68,22 +68,30 @@ void NeighborGrid<Dim>::sort(const std::vector<Vec<Dim>>& positions) {
     cells *= static_cast<uint64_t>(resolution_[k]);
   }
   cellCount_ = cells;
-  sparse_ = cells > std::max<uint64_t>(kDenseCellsMinimum, kDenseCellsPerParticle * n);
+  sparse_ = cells > std::max<uint64_t>(kDenseCellsMinimum, kDenseCellsPerParticle * n) || cells >= (uint64_t(1) << 32);
 
-  keyOfParticle_.resize(n);
   order_.resize(n);
+  if (!sparse_) {
+    // Counting sort: cell of each particle, histogram, exclusive prefix sum, stable placement.
+    keyOfParticle_.clear();
+    keyOfParticle_.shrink_to_fit();
+    cellOfParticle_.resize(n);
+    parallelFor(0, n, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) cellOfParticle_[i] = static_cast<uint32_t>(linearIndex(cellCoordinates(positions[i])));
+    });
+    cellStart_.assign(cells + 1, 0);
+    for (size_t i = 0; i < n; ++i) ++cellStart_[cellOfParticle_[i] + 1];
+    for (size_t c = 1; c < cellStart_.size(); ++c) cellStart_[c] += cellStart_[c - 1];
+    cursor_.assign(cellStart_.begin(), cellStart_.end() - 1);
+    for (size_t i = 0; i < n; ++i) order_[cursor_[cellOfParticle_[i]]++] = static_cast<uint32_t>(i);
+    return;
+  }
+  cellOfParticle_.clear();
+  cellOfParticle_.shrink_to_fit();
+  keyOfParticle_.resize(n);
   parallelFor(0, n, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) keyOfParticle_[i] = linearIndex(cellCoordinates(positions[i]));
   });
-  if (!sparse_) {
-    // Counting sort: histogram, exclusive prefix sum, stable placement.
-    cellStart_.assign(cells + 1, 0);
-    for (size_t i = 0; i < n; ++i) ++cellStart_[keyOfParticle_[i] + 1];
-    for (size_t c = 1; c < cellStart_.size(); ++c) cellStart_[c] += cellStart_[c - 1];
-    cursor_.assign(cellStart_.begin(), cellStart_.end() - 1);
-    for (size_t i = 0; i < n; ++i) order_[cursor_[keyOfParticle_[i]]++] = static_cast<uint32_t>(i);
-    return;
-  }
   // Sparse: sort (key, index) pairs, which are unique, so the result does not depend on the threads.
   for (size_t i = 0; i < n; ++i) order_[i] = static_cast<uint32_t>(i);
   tbb::parallel_sort(order_.begin(), order_.end(), [&](uint32_t a, uint32_t b) {
@@ -151,7 +159,15 @@ void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radi
                 candidates += rowEnd[rows] - rowBegin[rows];
               }
             // Room for every candidate, then keep those in range: no capacity check per neighbour.
-            if (chunk.size() < used + candidates) chunk.resize(2 * (used + candidates));
+            if (chunk.size() < used + candidates) {
+              // Grow to what the whole chunk will likely need (the mean so far times the chunk, plus a tenth),
+              // exactly: resize() alone would double.
+              const size_t done = i - c * kChunk;  // particles of this chunk already listed
+              const size_t expected = done ? used * kChunk / done : 0;
+              const size_t room = std::max(used, expected + expected / 10) + candidates;
+              chunk.reserve(room);
+              chunk.resize(room);
+            }
             uint32_t* out = chunk.data() + used;
             for (int row = 0; row < rows; ++row)
               for (uint32_t j = rowBegin[row]; j < rowEnd[row]; ++j) {

@@ -26,7 +26,9 @@ struct NeighborLists {
   std::vector<std::vector<uint32_t>> chunks;
 
   size_t size() const { return ends.size(); }
-  const uint32_t* begin(size_t i) const { return chunks[i / kChunk].data() + (i % kChunk ? ends[i - 1] : 0); }
+  // Where particle i's run starts in its chunk's array (also indexes arrays kept parallel to the lists).
+  size_t start(size_t i) const { return i % kChunk ? ends[i - 1] : 0; }
+  const uint32_t* begin(size_t i) const { return chunks[i / kChunk].data() + start(i); }
   const uint32_t* end(size_t i) const { return chunks[i / kChunk].data() + ends[i]; }
   size_t count(size_t i) const { return end(i) - begin(i); }
   size_t total() const {
@@ -71,7 +73,8 @@ class NeighborGrid {
   std::vector<uint32_t> cellStart_;    // dense: per cell, its first slot (plus one entry at the end)
   std::vector<uint64_t> cellKeys_;     // sparse: the occupied cells' linear indices, ascending
   std::vector<uint32_t> sparseStart_;  // sparse: per occupied cell, its first slot (plus one at the end)
-  std::vector<uint64_t> keyOfParticle_;
+  std::vector<uint32_t> cellOfParticle_;  // dense: each particle's cell
+  std::vector<uint64_t> keyOfParticle_;   // sparse: each particle's 64-bit cell key
   std::vector<uint32_t> order_;
   std::vector<uint32_t> cursor_;
 };

@@ -131,10 +131,8 @@ void PbfSolver<Dim>::setParticles(const ParticleFrame& frame) {
   x_.resize(n);
   v_.resize(n);
   p_.resize(n);
-  delta_.resize(n);
   id_ = frame.id;
   lambda_.assign(n, 0.0f);
-  density_.assign(n, 0.0f);
   for (size_t i = 0; i < n; ++i) {
     x_[i] = frame.position[i].head<Dim>();
     v_[i] = frame.velocity[i].head<Dim>();
@@ -191,6 +189,14 @@ void PbfSolver<Dim>::findNeighbors() {
   gatherByOrder(order, p_, scratch_);
   gatherByOrder(order, id_, scratchIds_);
   grid_.findNeighbors(p_, kernels_.radius(), neighbors_);
+  pairGradientFactors_.resize(neighbors_.chunks.size());
+  for (size_t c = 0; c < neighbors_.chunks.size(); ++c) {
+    const size_t last = std::min(size(), (c + 1) * NeighborLists::kChunk) - 1;
+    if (pairGradientFactors_[c].size() < neighbors_.ends[last]) {
+      pairGradientFactors_[c].reserve(neighbors_.chunks[c].size());
+      pairGradientFactors_[c].resize(neighbors_.ends[last]);
+    }
+  }
   times_.neighbors += millisecondsSince(start);
 }
 
@@ -223,10 +229,12 @@ double PbfSolver<Dim>::computeLambdas() {
       float weight = selfWeight;
       VecD gradientSum = VecD::Zero();  // sum_j grad W, times m / rho_0 below
       float gradientSquaredSum = 0;     // sum_j |grad W|^2, times (m / rho_0)^2 below
+      float* factor = pairGradientFactors_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
         const VecD r = pairOffset(i, *j, pi - p_[*j]);
         const float r2 = r.squaredNorm();
         const auto k = kernels_.pair(r2);
+        *factor++ = k.gradientFactor;
         weight += k.weight;
         gradientSum += k.gradientFactor * r;
         gradientSquaredSum += k.gradientFactor * k.gradientFactor * r2;
@@ -236,8 +244,7 @@ double PbfSolver<Dim>::computeLambdas() {
       VecD wallGradient = VecD::Zero();
       addWallTerms(p_[i], weight, wallGradient);
       gradientI += massOverRho_ * wallGradient;
-      density_[i] = mass_ * weight;
-      const float constraint = std::max(density_[i] / restDensity_ - 1.0f, 0.0f);
+      const float constraint = std::max(mass_ * weight / restDensity_ - 1.0f, 0.0f);
       lambda_[i] = -constraint / (gradientSquaredSum + gradientI.squaredNorm() + epsilon_);
       errorSum += constraint;
     }
@@ -259,31 +266,34 @@ double PbfSolver<Dim>::computeLambdas() {
 template <int Dim>
 void PbfSolver<Dim>::applyPositionCorrections() {
   const bool scorr = scorrK_ > 0;
+  scratch_.resize(size());  // the corrections, applied after all are computed (Jacobi)
   const float scorrScale = scorrK_ / latticeGradientSum_;
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const VecD pi = p_[i];
       const float lambdaI = lambda_[i];
       VecD delta = VecD::Zero();
-      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
+      const float* factor = pairGradientFactors_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++factor) {
         const VecD r = pairOffset(i, *j, pi - p_[*j]);
-        const auto k = kernels_.pair(r.squaredNorm());
         float coefficient = lambdaI + lambda_[*j];
-        if (scorr && coefficient == 0.0f)
-          coefficient = -scorrScale * std::max(integerPower(k.weight * scorrInvWdq_, scorrN_) - scorrAtRest_, 0.0f);
-        delta += (coefficient * k.gradientFactor) * r;
+        if (scorr && coefficient == 0.0f) {
+          const float weight = kernels_.poly6(r.squaredNorm());
+          coefficient = -scorrScale * std::max(integerPower(weight * scorrInvWdq_, scorrN_) - scorrAtRest_, 0.0f);
+        }
+        delta += (coefficient * *factor) * r;
       }
       // The walls do not move and carry no constraint of their own: only lambda_i acts along their gradient.
       float unusedWeight = 0;
       VecD wallGradient = VecD::Zero();
       addWallTerms(p_[i], unusedWeight, wallGradient);
       delta += lambda_[i] * wallGradient;
-      delta_[i] = massOverRho_ * delta;
+      scratch_[i] = massOverRho_ * delta;
     }
   });
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
-      p_[i] += delta_[i];
+      p_[i] += scratch_[i];
       clampToWalls(p_[i]);
     }
   });

@@ -87,15 +87,18 @@ class PbfSolver {
   float wallTableScale_ = 0;
 
   // Particle channels (structure of arrays) and the neighbour grid.
-  std::vector<VecD> x_, v_, p_, delta_;
+  std::vector<VecD> x_, v_, p_;
   std::vector<uint32_t> id_;
-  std::vector<float> lambda_, density_;
+  std::vector<float> lambda_;
   std::vector<VecD> omega3_;    // vorticity (3D); allocated only when vorticity confinement is on
   std::vector<float> omega2_;   // vorticity (2D, a scalar)
-  std::vector<VecD> scratch_;
+  std::vector<VecD> scratch_;  // reordering, position corrections and XSPH velocities, in turn
   std::vector<uint32_t> scratchIds_;
   NeighborGrid<Dim> grid_;
   NeighborLists neighbors_;
+  // Per neighbour pair, parallel to neighbors_: the spiky gradient factor g of Kernels::pair, computed by the
+  // lambda pass and reused by the position-correction pass of the same iteration (same positions).
+  std::vector<std::vector<float>> pairGradientFactors_;
 
   int lastIterations_ = 0;
   PhaseTimes times_;

@@ -1,19 +1,18 @@
 // The surfacer: particles -> level set -> mesh, with OpenVDB 10. This is the one file of Surge that includes
 // OpenVDB's tools (40-55 s to compile); everything else sees only surfacer.h.
 //
-// Method: the union of particle spheres (tools::ParticlesToLevelSet, Museth's narrow-band rasteriser),
-// re-distanced by fast sweeping (tools::sdfToSdf), smoothed by mean-curvature flow and eroded back to the
-// fluid's volume (tools::LevelSetFilter, which renormalises the band with LevelSetTracker after every step),
+// Method: a raw level set from particle_field.h (union of spheres, Zhu & Bridson blend or Yu & Turk
+// anisotropic kernels, by surface.method), re-distanced (LevelSetTracker), smoothed by mean-curvature flow and
+// eroded back to the fluid's volume (tools::LevelSetFilter, which renormalises the band with LevelSetTracker after every step),
 // meshed by tools::volumeToMesh at isovalue 0.
 #include "surface/surfacer.h"
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/ChangeBackground.h>
-#include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetFilter.h>
-#include <openvdb/tools/ParticlesToLevelSet.h>
+#include <openvdb/tools/SignedFloodFill.h>
 #include <openvdb/tools/VolumeToMesh.h>
 #include <unistd.h>
 
@@ -21,12 +20,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "core/errors.h"
 #include "core/parallel.h"
+#include "surface/anisotropy.h"
+#include "surface/particle_field.h"
+#include "surface/vdb_output.h"
 
 namespace surge {
 namespace {
@@ -39,24 +42,49 @@ constexpr double kHalfWidthVoxels = 3.0;
 // along z (z = -3h .. +3h): a closed solid about 7 spacings thick once eroded, thick enough that the two
 // faces of the slab never merge under smoothing, and thin enough to cost only 7x the spheres of the frame.
 constexpr int kSlabHalfLayers = 3;
-// Mean-curvature flow steps, before the erosion: enough to take out the bumps of the sphere union (on a flat
-// face they go from 0.04 to 0.004 spacings rms in two steps; each step moves the surface by a third of a voxel
-// times its curvature in voxels), few enough to keep edges and small droplets.
-constexpr int kSmoothingSteps = 2;
+// Mean-curvature flow steps (surface.smoothing_steps, default 2): enough to take out the bumps of the sphere
+// union (on a flat face they go from 0.04 to 0.004 spacings rms in two steps; each step moves the surface by
+// a third of a voxel times its curvature in voxels), few enough to keep edges and small droplets.
 // How far below the sphere tops (in spacings) the smoothed union of spheres of radius = spacing lies on a flat
 // face of a square lattice, measured: with it, the faces of a 20x10x10 block's mesh land within 0.002
 // spacings of the fluid's faces (the mean bump height alone, computed, would give 0.089; the smoothing takes
 // the rest). For radii other than the spacing it is an approximation.
 constexpr double kDentFill = 0.15;
+// Eikonal iterations of the re-distancing: the band is 3 voxels each side and one iteration moves correct
+// distances about a voxel, so 3 reach across it (LevelSetTracker's default is 1, meant for a band already
+// nearly right after one step of motion).
+constexpr int kRenormalise = 3;
 
 void initOpenVdb() {
   static std::once_flag once;
   std::call_once(once, [] { openvdb::initialize(); });
 }
 
+// Smooth spheres (ZB05): weights' support R = 2 spacings (the simulator's kernel radius), sphere radius r as
+// for `spheres`. The blend x-bar lies under the outer layer of a flat face, by kZbInset spacings (measured on
+// the test block), so the erosion for this method is r - 0.5 h - kZbInset h.
+constexpr double kZbSupport = 2.0;
+constexpr double kZbInset = 0.0;
+// Anisotropic (YT13): kernel support h = 2 spacings, PCA radius 3 spacings (YT13 take 2h; 3 spacings already
+// gives 60 neighbours to a particle of a flat face, above N_epsilon = 25, for a third of the cost), iso-value
+// half the rest field, and the flat face found kAnisoInset spacings under the fluid's face (measured on the
+// test block), eroded by that much (negative: dilated).
+constexpr double kAnisoSupport = 2.0;
+constexpr double kAnisoPca = 3.0;
+constexpr double kAnisoIso = 0.5;
+constexpr double kAnisoInset = 0.0;
+
+FloatGrid::Ptr emptyLevelSet(double voxel) {
+  FloatGrid::Ptr grid = openvdb::createLevelSet<FloatGrid>(voxel, kHalfWidthVoxels);
+  grid->setName("surface");
+  grid->setGridClass(openvdb::GRID_LEVEL_SET);
+  return grid;
+}
+
 struct Parameters {
   double spacing = 0, radius = 0, voxel = 0;
   int layers = 1;  // copies of each particle along z (1 in 3D)
+  std::string method;
 };
 
 Parameters resolve(const ParticleFrame& frame, const Scene& scene) {
@@ -66,35 +94,40 @@ Parameters resolve(const ParticleFrame& frame, const Scene& scene) {
   p.radius = scene.surface.particle_radius > 0 ? scene.surface.particle_radius : p.spacing;
   p.voxel = scene.surface.voxel_size > 0 ? scene.surface.voxel_size : p.radius / 2;
   p.layers = frame.dimensions == 2 ? 2 * kSlabHalfLayers + 1 : 1;
+  p.method = scene.surface.method;
   return p;
 }
 
-// The particle list that ParticlesToLevelSet reads (a duck-typed interface): positions straight out of the
-// ParticleFrame, no copy. In 2D, index i is layer i % layers of particle i / layers, shifted along z.
-class ParticleAdapter {
- public:
-  using PosType = openvdb::Vec3R;  // what PointPartitioner expects
-
-  ParticleAdapter(const ParticleFrame& frame, const Parameters& p) : frame_(frame), p_(p) {}
-
-  size_t size() const { return frame_.size() * size_t(p_.layers); }
-
-  void getPos(size_t i, openvdb::Vec3R& xyz) const {
-    const size_t layers = size_t(p_.layers);
-    const Eigen::Vector3f& x = frame_.position[i / layers];
-    const double z = layers == 1 ? double(x.z()) : (double(i % layers) - kSlabHalfLayers) * p_.spacing;
-    xyz = openvdb::Vec3R(x.x(), x.y(), z);
+// Particles as the surfacer sees them: the frame's, or in 2D 2 * kSlabHalfLayers + 1 copies of them spaced
+// particle_spacing along z (positions; velocities are copied with vz = 0).
+std::vector<Eigen::Vector3f> slabPositions(const ParticleFrame& frame, const Parameters& p,
+                                           const std::vector<Eigen::Vector3f>& values, bool isPosition) {
+  if (p.layers == 1) return values;
+  std::vector<Eigen::Vector3f> out(values.size() * size_t(p.layers));
+  for (size_t i = 0; i < out.size(); ++i) {
+    Eigen::Vector3f x = values[i / size_t(p.layers)];
+    x.z() = isPosition ? float((double(i % size_t(p.layers)) - kSlabHalfLayers) * p.spacing) : 0.f;
+    out[i] = x;
   }
+  (void)frame;
+  return out;
+}
 
-  void getPosRad(size_t i, openvdb::Vec3R& xyz, openvdb::Real& radius) const {
-    getPos(i, xyz);
-    radius = p_.radius;
+// A level set from blocks of distances (particle_field.h): one leaf per block, every voxel of it active, the
+// tiles around them given their sign by a flood fill (blocks wholly inside were never made).
+FloatGrid::Ptr gridFromBlocks(const BlockField& blocks, double voxel) {
+  FloatGrid::Ptr grid = emptyLevelSet(voxel);
+  auto& tree = grid->tree();
+  for (size_t b = 0; b < blocks.origins.size(); ++b) {
+    const Eigen::Vector3i& o = blocks.origins[b];
+    auto* leaf = new FloatGrid::TreeType::LeafNodeType(openvdb::Coord(o.x(), o.y(), o.z()), 0.f, true);
+    std::copy(blocks.values.begin() + ptrdiff_t(b * kBlockVoxels),
+              blocks.values.begin() + ptrdiff_t((b + 1) * kBlockVoxels), leaf->buffer().data());
+    tree.addLeaf(leaf);
   }
-
- private:
-  const ParticleFrame& frame_;
-  const Parameters& p_;
-};
+  openvdb::tools::signedFloodFill(tree);
+  return grid;
+}
 
 // OpenVDB's interrupter interface over Surge's Ctrl-C flag: a long frame stops inside OpenVDB's loops, and the
 // caller turns the flag into surge::Interrupted with Progress::checkInterrupt().
@@ -104,62 +137,90 @@ struct CtrlCInterrupter {
   bool wasInterrupted(int = -1) { return Progress::wasInterrupted(); }
 };
 
-FloatGrid::Ptr emptyLevelSet(double voxel) {
-  FloatGrid::Ptr grid = openvdb::createLevelSet<FloatGrid>(voxel, kHalfWidthVoxels);
-  grid->setName("surface");
-  grid->setGridClass(openvdb::GRID_LEVEL_SET);
-  return grid;
-}
-
-// The level set of a frame: sphere union, re-distancing, smoothing, erosion.
-FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
-  initOpenVdb();
-  const Parameters p = resolve(frame, scene);
-  FloatGrid::Ptr grid = emptyLevelSet(p.voxel);
-  if (frame.size() == 0) return grid;
-
-  CtrlCInterrupter interrupter;
-  const ParticleAdapter particles(frame, p);
-  {
-    openvdb::tools::ParticlesToLevelSet<FloatGrid, void, CtrlCInterrupter> raster(*grid, &interrupter);
-    // Spheres under getRmin() (1.5) voxels are skipped without a word; the scene loader forbids that
-    // voxel size, but a hand-made Scene may not have gone through it.
-    if (p.radius / p.voxel < raster.getRmin())
-      throw RunError("surface: particle_radius " + std::to_string(p.radius) + " is under 1.5 voxels of " +
-                     std::to_string(p.voxel) + "; OpenVDB would drop every particle");
-    // The fixed-radius path counts skipped particles exactly (all or none); the per-particle-radius path
-    // (getPosRad) is there for later, with radii per particle.
-    raster.rasterizeSpheres(particles, p.radius);
-    raster.finalize(/*prune=*/true);
-    if (raster.getMinCount() != 0 || raster.getMaxCount() != 0)
-      throw RunError("surface: OpenVDB dropped " + std::to_string(raster.getMinCount() + raster.getMaxCount()) +
-                     " particle spheres as too small or too large for voxel size " + std::to_string(p.voxel));
+// The raw level set of a frame's particles, by method: distances right near the zero crossing, roughly
+// right (clamped to the band) elsewhere.
+FloatGrid::Ptr rawLevelSet(const ParticleFrame& frame, const Parameters& p) {
+  const std::vector<Eigen::Vector3f> x = slabPositions(frame, p, frame.position, true);
+  const double band = kHalfWidthVoxels * p.voxel;
+  FieldParticles particles;
+  particles.position = &x;
+  FieldParameters f;
+  f.voxel = p.voxel;
+  f.band = band;
+  f.radius = p.radius;
+  f.occupancyCell = 2 * p.spacing;
+  AnisotropicKernels kernels;
+  if (p.method == "spheres") {
+    f.kind = FieldKind::Spheres;
+  } else if (p.method == "smooth_spheres") {
+    f.kind = FieldKind::SmoothSpheres;
+    f.support = kZbSupport * p.spacing;
+  } else if (p.method == "anisotropic") {
+    AnisotropyParameters a;
+    a.spacing = p.spacing;
+    a.supportRadius = kAnisoSupport * p.spacing;
+    a.pcaRadius = kAnisoPca * p.spacing;
+    kernels = anisotropicKernels(x, a);
+    particles.kernels = &kernels;
+    f.kind = FieldKind::Anisotropic;
+    f.iso = kAnisoIso;
+    f.volume = p.spacing * p.spacing * p.spacing;
+    // Inside a fluid at rest f = 1: (1 - iso) * scale must exceed the band, so that blocks wholly inside are
+    // recognised as such and never built.
+    f.distanceScale = 1.2 * band / (1 - kAnisoIso);
+  } else {
+    throw RunError("surface: unknown surface.method \"" + p.method + "\"");
   }
   Progress::checkInterrupt();
+  return gridFromBlocks(rasterizeField(particles, f), p.voxel);
+}
 
-  // The union of sphere distances is exact outside the spheres but not inside them (deep inside, a voxel holds
-  // the distance to the surface of its nearest sphere, not of the union), so the band is first re-distanced
-  // from its zero crossing (tools::sdfToSdf, fast sweeping) and trimmed back to the narrow band.
-  // sdfToSdf leaves an asymmetric background (the extreme distances found); it is set back to +-3 voxels.
-  grid = openvdb::tools::sdfToSdf(*grid);
-  grid->setName("surface");
-  grid->setGridClass(openvdb::GRID_LEVEL_SET);
-  openvdb::tools::changeLevelSetBackground(grid->tree(), float(kHalfWidthVoxels * p.voxel));
-  Progress::checkInterrupt();
-  openvdb::tools::LevelSetFilter<FloatGrid, FloatGrid, CtrlCInterrupter> filter(*grid, &interrupter);
-  filter.prune();  // voxels now beyond the band become inactive background
-
-  // Smooth first, erode second: mean-curvature flow fills the dents between the spheres and rounds the sphere
-  // caps, the erosion then takes the surface back to the fluid. (Eroding first would leave a lone particle
-  // a sphere of one voxel, which smoothing then erases.)
-  for (int i = 0; i < kSmoothingSteps; ++i) filter.meanCurvature();
+// How far to erode (positive) the smoothed level set of each method so that a flat face of a resting fluid
+// lands on the fluid's face, h/2 beyond the centres of its outer layer.
+double erosionOf(const Parameters& p) {
   // Each particle stands for a cube of fluid of side h = spacing, so a flat face of the fluid lies h/2 beyond
   // the centres of its outer layer, while the sphere union reaches `radius` beyond them at the centres and
   // h/sqrt(2) (for radius = h) between them. Eroding by radius - h/2 would put the sphere tops on the
   // fluid's face; the smoothed surface lies kDentFill * h under the tops, so that much less is eroded and the
   // faces land on the fluid's (a 20x10x10 block then encloses N h^3 less 1.7%, lost at its rounded edges).
+  if (p.method == "spheres") return p.radius - 0.5 * p.spacing - kDentFill * p.spacing;
+  if (p.method == "smooth_spheres") return p.radius - 0.5 * p.spacing - kZbInset * p.spacing;
+  return -kAnisoInset * p.spacing;
+}
+
+// The level set of a frame: raw field, re-distancing, smoothing, erosion.
+FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
+  initOpenVdb();
+  const Parameters p = resolve(frame, scene);
+  FloatGrid::Ptr grid = emptyLevelSet(p.voxel);
+  if (frame.size() == 0) return grid;
+  // Spheres under 1.5 voxels are under-resolved: OpenVDB's own rasteriser skips them without a word, and the
+  // smoothing below would erase what is left. The scene loader forbids such voxels; a hand-made Scene may not
+  // have gone through it.
+  if (p.radius / p.voxel < 1.5)
+    throw RunError("surface: particle_radius " + std::to_string(p.radius) + " is under 1.5 voxels of " +
+                   std::to_string(p.voxel) + "; the particles' spheres would be lost");
+  CtrlCInterrupter interrupter;
+  grid = rawLevelSet(frame, p);
+  Progress::checkInterrupt();
+
+  // The raw distances are right outside the spheres but not inside them (a voxel holds the distance to the
+  // surface of its nearest sphere, not of the union), nor for the blended fields. LevelSetTracker's
+  // normalisation (Eikonal iterations in the band, kRenormalise of them) puts the band right from the zero
+  // crossing outward, and trims it back to the narrow band. (tools::sdfToSdf, fast sweeping, did the same
+  // here first and took 90% of the time: 85 s for a million particles, against 1.5 s for this.)
+  openvdb::tools::LevelSetFilter<FloatGrid, FloatGrid, CtrlCInterrupter> filter(*grid, &interrupter);
+  filter.setNormCount(kRenormalise);
+  filter.normalize();
+  filter.prune();  // voxels now beyond the band become inactive background
+  Progress::checkInterrupt();
+
+  // Smooth first, erode second: mean-curvature flow fills the dents between the spheres and rounds the sphere
+  // caps, the erosion then takes the surface back to the fluid. (Eroding first would leave a lone particle
+  // a sphere of one voxel, which smoothing then erases.)
+  for (int i = 0; i < scene.surface.smoothing_steps; ++i) filter.meanCurvature();
   // Positive offsets shrink the level set (phi + offset, phi < 0 inside).
-  const double erosion = p.radius - 0.5 * p.spacing - kDentFill * p.spacing;
+  const double erosion = erosionOf(p);
   if (erosion != 0) filter.offset(float(erosion));
   Progress::checkInterrupt();
   return grid;
@@ -232,26 +293,28 @@ TriangleMesh meshLevelSet(const FloatGrid& grid, double adaptivity) {
   return mesh;
 }
 
-// openvdb::io::File writes to a path, not a stream, so the atomic write is done here: a temporary name in
-// the same folder (same file system, so the rename is atomic), then rename.
-void writeVdbAtomically(const FloatGrid::Ptr& grid, const fs::path& path) {
-  if (path.has_parent_path()) fs::create_directories(path.parent_path());
-  fs::path temporary = path;
-  temporary += ".tmp" + std::to_string(::getpid());
-  try {
-    openvdb::io::File file(temporary.string());
-    file.write(openvdb::GridPtrVec{grid});
-    file.close();
-    fs::rename(temporary, path);
-  } catch (const openvdb::Exception& e) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
-    throw RunError("cannot write " + path.string() + ": " + e.what());
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
-    throw;
-  }
+// OBJ with vertex normals (v, vn, f a//a), 1-based indices, as text: Blender and Houdini read it.
+void writeMeshObj(const fs::path& path, const TriangleMesh& mesh) {
+  writeFileAtomically(path, [&](std::ostream& out) {
+    char line[128];
+    for (const auto& x : mesh.positions) {
+      std::snprintf(line, sizeof line, "v %.7g %.7g %.7g\n", double(x.x()), double(x.y()), double(x.z()));
+      out << line;
+    }
+    for (const auto& n : mesh.normals) {
+      std::snprintf(line, sizeof line, "vn %.6g %.6g %.6g\n", double(n.x()), double(n.y()), double(n.z()));
+      out << line;
+    }
+    const bool normals = !mesh.normals.empty();
+    for (const auto& t : mesh.triangles) {
+      if (normals)
+        std::snprintf(line, sizeof line, "f %u//%u %u//%u %u//%u\n", t[0] + 1, t[0] + 1, t[1] + 1, t[1] + 1,
+                      t[2] + 1, t[2] + 1);
+      else
+        std::snprintf(line, sizeof line, "f %u %u %u\n", t[0] + 1, t[1] + 1, t[2] + 1);
+      out << line;
+    }
+  });
 }
 
 }  // namespace
@@ -260,8 +323,44 @@ SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const 
                           const fs::path& meshPath) {
   const FloatGrid::Ptr grid = buildLevelSet(frame, scene);
   const TriangleMesh mesh = meshLevelSet(*grid, scene.surface.adaptivity);
-  writeVdbAtomically(grid, vdbPath);
+
+  const Parameters p = resolve(frame, scene);
+  VdbExtras extras;
+  BlockField velocity;
+  std::vector<Eigen::Vector3f> x, v;
+  if (scene.surface.write_velocity || scene.surface.write_points) {
+    x = slabPositions(frame, p, frame.position, true);
+    v = slabPositions(frame, p, frame.velocity, false);
+  }
+  if (scene.surface.write_velocity) {
+    // The Shepard average of the particle velocities (ZB05 weights, support 2 spacings) on every voxel of the
+    // surface's leaves, where a renderer's motion blur or a re-simulation looks them up.
+    std::vector<Eigen::Vector3i> leaves;
+    for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
+      const openvdb::Coord o = leaf->origin();
+      leaves.emplace_back(o.x(), o.y(), o.z());
+    }
+    FieldParticles particles;
+    particles.position = &x;
+    particles.velocity = &v;
+    FieldParameters f;
+    f.kind = FieldKind::Velocity;
+    f.voxel = p.voxel;
+    f.support = kZbSupport * p.spacing;
+    velocity = rasterizeField(particles, f, &leaves);
+    extras.velocity = &velocity;
+  }
+  if (scene.surface.write_points) {
+    extras.pointPositions = &x;
+    extras.pointVelocities = &v;
+    extras.pointVoxel = 4 * p.spacing;  // about 64 particles per voxel of the points grid
+  }
+  writeSurfaceVdb(vdbPath, grid, extras);
   writeMeshPly(meshPath, mesh);
+  if (scene.surface.write_obj) {
+    fs::path obj = meshPath;
+    writeMeshObj(obj.replace_extension(".obj"), mesh);
+  }
   SurfaceStats stats;
   stats.particles = frame.size();
   stats.activeVoxels = size_t(grid->activeVoxelCount());
@@ -280,12 +379,22 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
     throw InputError(dir.string(), "--frames", "no particle frame in " + std::to_string(range.first) + ":" +
                                                   std::to_string(range.last));
   progress.start("surface", frames.size());
-  for (int f : frames) {
-    Progress::checkInterrupt();
-    const ParticleFrame frame = readParticlePly(framePath(dir, "particles", f, "ply"));
-    surfaceFrame(frame, scene, framePath(dir, "surface", f, "vdb"), framePath(dir, "surface", f, "ply"));
-    progress.advance();
-  }
+  // Frames in parallel, one chunk each (OpenVDB's and our own loops inside a frame share the same oneTBB
+  // workers). Each frame's files depend only on its particles, so the bytes are the same at any thread count.
+  std::mutex advance;
+  parallelFor(
+      0, frames.size(),
+      [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) {
+          Progress::checkInterrupt();
+          const int f = frames[i];
+          const ParticleFrame frame = readParticlePly(framePath(dir, "particles", f, "ply"));
+          surfaceFrame(frame, scene, framePath(dir, "surface", f, "vdb"), framePath(dir, "surface", f, "ply"));
+          const std::lock_guard<std::mutex> lock(advance);
+          progress.advance();
+        }
+      },
+      1);
   progress.finish();
 }
 

@@ -1,10 +1,12 @@
 // The surface stage: particle frames -> narrow-band level sets (OpenVDB) -> triangle meshes.
 //
-// Method (all OpenVDB 10, kept inside surfacer.cpp so that no other file pays for its headers):
-//  1. Rasterise one sphere per particle, radius scene.surface.particle_radius, into a narrow-band level set of
-//     voxel size scene.surface.voxel_size and half-width 3 voxels (tools::ParticlesToLevelSet, the union of
-//     the spheres' signed distances). No particle may be dropped: spheres under 1.5 voxels make this throw.
-//  2. Re-distance the union from its zero crossing (tools::sdfToSdf), smooth it by mean-curvature flow and
+// Method (OpenVDB 10 in surfacer.cpp and vdb_output.cpp only, so that no other file pays for its headers):
+//  1. A raw narrow-band level set of voxel size scene.surface.voxel_size and half-width 3 voxels, by
+//     scene.surface.method (particle_field.h, our own gather rasteriser, which never drops a particle):
+//     `spheres` (union of spheres of radius surface.particle_radius), `smooth_spheres` (Zhu & Bridson 2005),
+//     `anisotropic` (Yu & Turk 2013, anisotropy.h; iso-value not calibrated yet). Spheres under 1.5 voxels
+//     throw: the smoothing would erase them.
+//  2. Re-distance it (LevelSetTracker), smooth it by surface.smoothing_steps of mean-curvature flow and
 //     erode it back to the fluid's volume (tools::LevelSetFilter; spheres of radius ~ spacing make a block
 //     fatter than its N * spacing^3 of fluid).
 //  3. Mesh the zero crossing (tools::volumeToMesh), split quads into triangles, orient them outward and give
@@ -26,14 +28,16 @@ struct SurfaceStats {
   double voxelSize = 0;
 };
 
-// Level set of one particle frame -> mesh. Writes vdbPath (a level-set grid named "surface") and meshPath
-// (binary PLY with vertex normals), each atomically (temporary name in the same folder, then rename).
+// Level set of one particle frame -> mesh. Writes vdbPath (a level-set grid named "surface"; with
+// surface.write_velocity a vector grid "v", with surface.write_points a PointDataGrid "points" with attribute
+// "v") and meshPath (binary PLY with vertex normals; with surface.write_obj also an .obj beside it), each atomically (temporary name in the same folder, then rename).
 // Throws RunError if OpenVDB would drop a particle (sphere under 1.5 voxels), Interrupted on Ctrl-C.
 SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const fs::path& vdbPath,
                           const fs::path& meshPath);
 
 // The stage: for every dir/particles/frame_NNNNN.ply within range, writes dir/surface/frame_NNNNN.vdb and
-// dir/surface/frame_NNNNN.ply. Reports progress per frame ("surface") and checks for Ctrl-C between frames.
+// dir/surface/frame_NNNNN.ply, frames in parallel (parallelFor, one frame a chunk: the same bytes at any thread
+// count). Reports progress per frame ("surface") and checks for Ctrl-C between frames.
 // Throws InputError naming dir if there is no particle frame (in range).
 void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress);
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <string>
 
 #include "core/ply.h"
@@ -36,6 +37,45 @@ inline TriangleMesh boxMesh(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi
     mesh.triangles.push_back({uint32_t(f[0]), uint32_t(f[1]), uint32_t(f[2])});
     mesh.triangles.push_back({uint32_t(f[0]), uint32_t(f[2]), uint32_t(f[3])});
   }
+  return mesh;
+}
+
+// An axis-aligned box whose faces have their own vertices, with the face normals as vertex normals: smooth
+// shading must render it exactly like the flat box.
+inline TriangleMesh boxMeshWithFaceNormals(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
+  const TriangleMesh shared = boxMesh(lo, hi);
+  TriangleMesh mesh;
+  for (const auto& t : shared.triangles) {
+    const Eigen::Vector3f& a = shared.positions[t[0]];
+    const Eigen::Vector3f n = (shared.positions[t[1]] - a).cross(shared.positions[t[2]] - a).normalized();
+    for (uint32_t v : t) {
+      mesh.positions.push_back(shared.positions[v]);
+      mesh.normals.push_back(n);
+    }
+    const auto base = uint32_t(mesh.positions.size() - 3);
+    mesh.triangles.push_back({base, base + 1, base + 2});
+  }
+  return mesh;
+}
+
+// A UV sphere with outward vertex normals: `rings` bands of latitude, 2 x rings of longitude.
+inline TriangleMesh sphereMesh(const Eigen::Vector3f& centre, float radius, int rings) {
+  TriangleMesh mesh;
+  const int segments = 2 * rings;
+  for (int i = 0; i <= rings; ++i)
+    for (int j = 0; j <= segments; ++j) {
+      const float theta = float(M_PI) * i / rings, phi = 2.0f * float(M_PI) * j / segments;
+      const Eigen::Vector3f n(std::sin(theta) * std::cos(phi), std::cos(theta),
+                              std::sin(theta) * std::sin(phi));
+      mesh.positions.push_back(centre + radius * n);
+      mesh.normals.push_back(n);
+    }
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const auto a = uint32_t(i * (segments + 1) + j), b = a + uint32_t(segments + 1);
+      mesh.triangles.push_back({a, b, a + 1});
+      mesh.triangles.push_back({a + 1, b, b + 1});
+    }
   return mesh;
 }
 

@@ -23,8 +23,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-Scene sceneWithSpacing(double h, int dimensions = 3) {
+Scene sceneWithSpacing(double h, int dimensions = 3, const char* method = "spheres") {
   Scene scene;
+  scene.surface.method = method;
   scene.name = "surfacer_test";
   scene.dimensions = dimensions;
   scene.particle_spacing = h;
@@ -308,6 +309,123 @@ TEST(Surfacer, SurfaceFramesWritesEveryFrameInRange) {
   EXPECT_THROW(surfaceFrames(dir, scene, FrameRange{}, progress), Interrupted);
   EXPECT_THROW(meshParticles(block(3, 3, 3, h, Eigen::Vector3d::Zero()), scene), Interrupted);
   Progress::setInterrupted(false);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace surge
+
+namespace surge {
+namespace {
+
+// A resting block whose particles are jittered by up to `jitter` spacings (a fixed hash, no random state), as
+// a simulated fluid at rest is never an exact lattice.
+ParticleFrame jitteredBlock(int nx, int ny, int nz, double h, double jitter) {
+  ParticleFrame frame = block(nx, ny, nz, h, Eigen::Vector3d(0.01, 0.01, 0.01));
+  for (size_t i = 0; i < frame.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t bits = uint32_t(i * 2654435761u) ^ uint32_t((k + 1) * 40503u * (i + 7));
+      frame.position[i][k] += float(jitter * h * ((double(bits % 2001) / 1000.0) - 1.0));
+    }
+  return frame;
+}
+
+// Variance of the unit normals over the top face of a block (vertices within a quarter spacing of the top's
+// mean height, 3 spacings in from its edges): 0 for a perfectly flat face.
+double topNormalVariance(const TriangleMesh& mesh, double h, double x1, double z1, double yTop) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> normals;
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    const Eigen::Vector3d x = mesh.positions[i].cast<double>();
+    if (x.x() < 0.01 + 3 * h || x.x() > x1 - 3 * h || x.z() < 0.01 + 3 * h || x.z() > z1 - 3 * h) continue;
+    if (std::abs(x.y() - yTop) > h) continue;
+    normals.push_back(mesh.normals[i].cast<double>());
+    sum += normals.back();
+  }
+  const Eigen::Vector3d mean = sum / double(normals.size());
+  double variance = 0;
+  for (const auto& n : normals) variance += (n - mean).squaredNorm();
+  return variance / double(normals.size());
+}
+
+TEST(SurfacerMethods, EveryMethodKeepsTheBlocksVolumeAndIsClosed) {
+  const double h = 0.02;
+  const ParticleFrame frame = block(20, 10, 10, h, Eigen::Vector3d(0.11, 0.01, 0.01));
+  const double fluid = double(frame.size()) * h * h * h;
+  // anisotropic is left out: its iso-value is not calibrated yet (measured -37% and an open mesh; issue 5).
+  for (const char* method : {"spheres", "smooth_spheres"}) {
+    const TriangleMesh mesh = meshParticles(frame, sceneWithSpacing(h, 3, method));
+    const double volume = signedVolume(mesh);
+    std::printf("%s: block volume error %.2f%%, %zu triangles\n", method, 100 * (volume / fluid - 1),
+                mesh.triangles.size());
+    // 3%, argued as for `spheres` in RestingBlockEnclosesItsFluidVolumeAndIsClosed: the faces are calibrated
+    // onto the fluid's faces (kZbInset, kAnisoInset), the loss is at the rounded edges.
+    EXPECT_NEAR(volume / fluid, 1.0, 0.03) << method;
+    expectClosedAndOriented(mesh);
+    expectUnitNormals(mesh);
+  }
+}
+
+// DISABLED: fails today. Measured on this block: normal variance 0.0044 (spheres) against 0.043 (anisotropic):
+// the anisotropic field is not calibrated yet (see EveryMethodKeepsTheBlocksVolumeAndIsClosed). Kept as the
+// target of the remaining work of issue 5, not loosened.
+TEST(SurfacerMethods, DISABLED_AnisotropicKernelsLeaveAFlatSurfaceFlatterThanSpheres) {
+  const double h = 0.02;
+  const int nx = 20, ny = 8, nz = 20;
+  const ParticleFrame frame = jitteredBlock(nx, ny, nz, h, 0.1);
+  const double yTop = 0.01 + (ny - 1) * h + h / 2, x1 = 0.01 + (nx - 1) * h, z1 = 0.01 + (nz - 1) * h;
+  double variance[2];
+  const char* methods[2] = {"spheres", "anisotropic"};
+  for (int m = 0; m < 2; ++m) {
+    const TriangleMesh mesh = meshParticles(frame, sceneWithSpacing(h, 3, methods[m]));
+    variance[m] = topNormalVariance(mesh, h, x1, z1, yTop);
+    std::printf("%s: normal variance on the top face %.3g\n", methods[m], variance[m]);
+  }
+  // Strictly lower: the claim of YT13 (their Fig. 1 and 9) is qualitative, so the test asserts only the order,
+  // at the same voxel size and smoothing.
+  EXPECT_LT(variance[1], variance[0]);
+}
+
+TEST(SurfacerVdb, RoundTripsNameClassVoxelAndTransformWithVelocityAndPoints) {
+  const fs::path dir = uniqueTempDir();
+  const double h = 0.05;
+  ParticleFrame frame = block(6, 4, 5, h, Eigen::Vector3d(0.2, 0.1, 0.3));
+  for (auto& v : frame.velocity) v = Eigen::Vector3f(1.0f, -2.0f, 0.5f);
+  Scene scene = sceneWithSpacing(h);
+  scene.surface.write_velocity = 1;
+  scene.surface.write_points = 1;
+  scene.surface.write_obj = 1;
+  const fs::path vdb = dir / "f.vdb", ply = dir / "f.ply";
+  surfaceFrame(frame, scene, vdb, ply);
+  EXPECT_TRUE(fs::exists(dir / "f.obj"));
+
+  openvdb::initialize();
+  openvdb::io::File file(vdb.string());
+  file.open();
+  const openvdb::GridBase::Ptr surface = file.readGrid("surface");
+  ASSERT_TRUE(file.hasGrid("v"));
+  ASSERT_TRUE(file.hasGrid("points"));
+  const openvdb::GridBase::Ptr v = file.readGrid("v");
+  const openvdb::GridBase::Ptr points = file.readGrid("points");
+  file.close();
+  EXPECT_EQ(surface->getName(), "surface");
+  EXPECT_EQ(surface->getGridClass(), openvdb::GRID_LEVEL_SET);
+  EXPECT_EQ(surface->transform(), *openvdb::math::Transform::createLinearTransform(h / 2));
+  // The velocity grid shares the level set's transform; every particle moves alike, so every voxel's Shepard
+  // average is that velocity (to float rounding of sum w v / sum w, 1e-5 relative), or zero on voxels of the
+  // surface's leaves that no particle's support (2 spacings) reaches.
+  EXPECT_EQ(v->transform(), surface->transform());
+  const auto vgrid = openvdb::gridPtrCast<openvdb::Vec3SGrid>(v);
+  ASSERT_TRUE(vgrid);
+  size_t moving = 0, other = 0;
+  for (auto it = vgrid->cbeginValueOn(); it; ++it) {
+    if ((*it - openvdb::Vec3s(1.0f, -2.0f, 0.5f)).length() < 1e-5f) ++moving;
+    else if ((*it).length() != 0) ++other;
+  }
+  EXPECT_GT(moving, 0u);
+  EXPECT_EQ(other, 0u);
+  EXPECT_EQ(points->type(), "Tree_ptdataidx32_5_4_3");
+  EXPECT_TRUE(points->activeVoxelCount() > 0);
   fs::remove_all(dir);
 }
 

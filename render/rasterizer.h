@@ -1,0 +1,36 @@
+// The quick-look renderer: OSMesa (Mesa's off-screen GL, no display needed) rasterises the water mesh, or the
+// particles as shaded spheres, with the same camera, sky, sun and ground colours as the path tracer but no
+// refraction or shadows: each water vertex is a Fresnel blend (Schlick) of the sky it reflects and the
+// water's body colour, plus a sun highlight. Two-dimensional scenes are drawn face-on with an orthographic
+// camera as a clean picture of the fluid in the tank. Images are drawn at twice the resolution and averaged
+// down 2x2, for anti-aliased edges.
+#pragma once
+
+#include <memory>
+
+#include "core/ply.h"
+#include "core/scene.h"
+#include "render/image.h"
+
+namespace surge {
+
+class Rasterizer {
+ public:
+  // One GL context for the scene's resolved resolution (render.quality applies). Throws RunError if OSMesa
+  // cannot create it.
+  explicit Rasterizer(const Scene& scene);
+  ~Rasterizer();
+  Rasterizer(const Rasterizer&) = delete;
+  Rasterizer& operator=(const Rasterizer&) = delete;
+
+  // Throws InputError if a triangle names a vertex the mesh does not have.
+  Image drawMesh(const TriangleMesh& water);
+  // Spheres of radius particle_spacing / 2 (in 2D flat discs of 0.8 particle_spacing, overlapping).
+  Image drawParticles(const ParticleFrame& particles);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace surge

@@ -1,0 +1,27 @@
+// The VDB file of a surface frame, by Houdini's and Blender's conventions: the level set `surface` (grid class
+// level set), and on request a velocity grid `v` (a vector grid, vector type
+// contravariant-relative, as Houdini writes velocity fields) and the particles as a PointDataGrid `points` with a
+// float vector attribute `v`. Included only by surfacer.cpp (it pulls in OpenVDB's core headers).
+#pragma once
+
+#include <openvdb/openvdb.h>
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "core/files.h"
+#include "surface/particle_field.h"
+
+namespace surge {
+
+struct VdbExtras {
+  const BlockField* velocity = nullptr;  // blocks of 3 floats per voxel, on the surface's leaves
+  const std::vector<Eigen::Vector3f>* pointPositions = nullptr;
+  const std::vector<Eigen::Vector3f>* pointVelocities = nullptr;
+  double pointVoxel = 0;  // the points grid's voxel size
+};
+
+// Writes the grids to `path` atomically (a temporary name in the same folder, then rename). Throws RunError.
+void writeSurfaceVdb(const fs::path& path, const openvdb::FloatGrid::Ptr& surface, const VdbExtras& extras);
+
+}  // namespace surge
