@@ -1,11 +1,15 @@
 // Simulator benchmarks (issue: PBF solver). Counters:
 //   particle_iterations/s  particles x substeps x iterations per CPU-second of all threads (per core),
 //                          over whole steps (all phases); the Time column is process CPU time
-//   bytes_per_particle     the process's peak resident memory over the particle count
+//   bytes_per_particle     the process's peak resident memory, less what it held before the scene was made,
+//                          over the particle count (includes the initial particle frame and every channel)
 // Run: build/bench/surge_bench_sim [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 
+#include <unistd.h>
+
+#include <cstdio>
 #include <random>
 
 #include "core/parallel.h"
@@ -34,8 +38,20 @@ size_t peakResidentBytes() {
   return static_cast<size_t>(usage.ru_maxrss) * 1024;
 }
 
+size_t currentResidentBytes() {
+  long pages = 0, resident = 0;
+  if (FILE* statm = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(statm, "%ld %ld", &pages, &resident) != 2) resident = 0;
+    std::fclose(statm);
+  }
+  return static_cast<size_t>(resident) * static_cast<size_t>(sysconf(_SC_PAGESIZE));
+}
+
 void BM_PbfDamBreak(benchmark::State& state) {
   ThreadLimit threads(static_cast<int>(state.range(1)));
+  // Memory is measured from here: the process's own baseline (runtime, thread pool) is not the particles'.
+  // Runs go from small to large, so the peak seen at the end belongs to this run.
+  const size_t baseline = currentResidentBytes();
   const Scene scene = damBreak(static_cast<double>(state.range(0)));
   PbfSolver<3> solver(scene);
   solver.setParticles(initialParticles(scene));
@@ -52,7 +68,7 @@ void BM_PbfDamBreak(benchmark::State& state) {
   state.counters["particles"] = static_cast<double>(solver.size());
   state.counters["particle_iterations/s"] =
       benchmark::Counter(static_cast<double>(iterations * solver.size()), benchmark::Counter::kIsRate);
-  state.counters["bytes_per_particle"] = static_cast<double>(peakResidentBytes()) / solver.size();
+  state.counters["bytes_per_particle"] = static_cast<double>(peakResidentBytes() - baseline) / solver.size();
 }
 BENCHMARK(BM_PbfDamBreak)
     ->Args({100000, 1})
@@ -95,7 +111,8 @@ BENCHMARK(BM_GridRebuild)->Arg(0)->Arg(1)->ArgNames({"piled"})->Unit(benchmark::
 void BM_NeighborLists(benchmark::State& state) {
   const bool piled = state.range(0) == 1;
   std::vector<Vec<3>> x = latticeParticles(1000000, 0.01f, 7), scratch;
-  NeighborGrid<3> grid(Vec<3>(0, 0, 0), Vec<3>::Constant(piled ? 8.0f : 1.0f), 0.02f);
+  const float cellSize = state.range(1) == 2 ? 0.01f : 0.02f;
+  NeighborGrid<3> grid(Vec<3>(0, 0, 0), Vec<3>::Constant(piled ? 8.0f : 1.0f), cellSize);
   grid.sort(x);
   gatherByOrder(grid.sortedOrder(), x, scratch);
   NeighborLists lists;
@@ -105,7 +122,7 @@ void BM_NeighborLists(benchmark::State& state) {
   }
   state.counters["neighbors/particle"] = double(lists.total()) / double(x.size());
 }
-BENCHMARK(BM_NeighborLists)->Arg(0)->Arg(1)->ArgNames({"piled"})->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+BENCHMARK(BM_NeighborLists)->Args({0, 1})->Args({0, 2})->Args({1, 2})->ArgNames({"piled", "cells_per_radius"})->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
 }  // namespace
 }  // namespace surge

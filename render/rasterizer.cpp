@@ -90,14 +90,14 @@ struct Rasterizer::Impl {
   }
 
   // Water seen at a point with normal n from direction v: Fresnel blend of the reflected sky and the body
-  // colour (the water colour lit by sun and sky through its depth), plus the sun's highlight.
+  // colour (the floor lit by sun and sky seen through about half a metre of water), plus the sun's highlight.
   Vec3 waterColour(const Vec3& v, Vec3 n) const {
     if (n.dot(v) > 0) n = -n;
     const float c = std::clamp(-v.dot(n), 0.0f, 1.0f), m = 1.0f - c;
     const float fresnel = 0.02f + 0.98f * m * m * m * m * m;
     const Vec3 reflected = v - 2.0f * v.dot(n) * n;
     const Vec3 body = look.floorAlbedo * 0.55f *
-                      look.waterAbsorption.unaryExpr([](float a) { return std::exp(-0.5f * a);  // about 0.5 m of water between surface and eye })
+                      look.waterAbsorption.unaryExpr([](float a) { return std::exp(-0.5f * a); })
                           .cwiseProduct(diffuseLight(Vec3::UnitY()));
     const float highlight = std::pow(std::max(reflected.dot(look.sunDirection), 0.0f), 400.0f);
     return (1.0f - fresnel) * body + fresnel * skyRadiance(look, reflected) +

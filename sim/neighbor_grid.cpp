@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "core/parallel.h"
 
@@ -126,6 +127,9 @@ template <int Dim>
 void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radius, NeighborLists& lists) const {
   const size_t n = x.size();
   const float r2 = radius * radius;
+  // Cells of half the radius are searched two cells out: fewer candidates than cells of the radius.
+  const int64_t reach = static_cast<int64_t>(std::ceil(radius / cellSize_ - 1e-4f));
+  if (reach < 1 || reach > 2) throw std::invalid_argument("NeighborGrid: radius must be 1 or 2 cells");
   constexpr size_t kChunk = NeighborLists::kChunk;
   const size_t chunks = (n + kChunk - 1) / kChunk;
   lists.ends.resize(n);
@@ -142,10 +146,10 @@ void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radi
             const Cell cell = cellCoordinates(xi);
             Cell lo = cell, hi = cell;
             for (int k = 0; k < Dim; ++k) {
-              lo[k] = std::max<int64_t>(cell[k] - 1, 0);
-              hi[k] = std::min<int64_t>(cell[k] + 1, resolution_[k] - 1);
+              lo[k] = std::max<int64_t>(cell[k] - reach, 0);
+              hi[k] = std::min<int64_t>(cell[k] + reach, resolution_[k] - 1);
             }
-            constexpr int kRows = Dim == 3 ? 9 : 3;
+            constexpr int kRows = Dim == 3 ? 25 : 5;  // rows of a stencil of reach 2
             uint32_t rowBegin[kRows], rowEnd[kRows];
             int rows = 0;
             size_t candidates = 0;

@@ -1,12 +1,13 @@
-// Neighbour search on a uniform grid of cells the size of the kernel radius (after Green's "Particle
+// Neighbour search on a uniform grid of cells of the kernel radius or half of it (after Green's "Particle
 // Simulation using CUDA" and SPlisHSPlasH's CompactNSearch). Each sort() lays the grid over the particles'
 // bounding box (clipped to the domain), so a small body of fluid in a large tank costs no more than in a small
 // one. Particles are sorted into cells in linear cell order (x fastest): with a counting sort over a dense array
 // of cells when the box holds at most a few cells per particle, else (fluid spread thinly over a large domain)
 // by sorting 64-bit cell keys and keeping only the occupied cells. The caller reorders its particle arrays by
 // the sorted order so neighbours sit close in memory, and neighbour lists are built into flat arrays. A row of
-// three cells along x is one contiguous run of particles, so a query reads 3 runs in 2D and 9 in 3D; piling
-// every particle into a few cells costs nothing beyond the neighbour pairs themselves.
+// cells along x is one contiguous run of particles, so a query reads one run per row of its stencil (3 or 5
+// cells a side, for cells of the radius or half of it); piling every particle into a few cells costs nothing
+// beyond the neighbour pairs themselves.
 #pragma once
 
 #include <cstdint>
@@ -50,7 +51,7 @@ class NeighborGrid {
   const std::vector<uint32_t>& sortedOrder() const { return order_; }
 
   // For positions in the order of the last sort(): lists, for each particle, every other particle closer than
-  // `radius` (at most the cell size), in increasing index order.
+  // `radius` (one or two cell sizes), in increasing index order.
   void findNeighbors(const std::vector<Vec<Dim>>& sortedPositions, float radius, NeighborLists& lists) const;
 
   // Cells of the last sort's box, and whether it used the sparse (sorted keys) path.

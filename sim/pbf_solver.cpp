@@ -50,8 +50,9 @@ void restLatticeSums(const Kernels<Dim>& kernels, float spacing, double* weightS
 template <int Dim>
 PbfSolver<Dim>::PbfSolver(const Scene& scene)
     : kernels_(static_cast<float>(scene.solver.kernel_radius)),
+      // Cells of half the kernel radius: searching 5 cells a side reads fewer candidates than 3 of the radius.
       grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
-            static_cast<float>(scene.solver.kernel_radius)) {
+            static_cast<float>(0.5 * scene.solver.kernel_radius)) {
   const SolverSettings& s = scene.solver;
   const float spacing = static_cast<float>(scene.particle_spacing);
   restDensity_ = static_cast<float>(s.rest_density);
@@ -231,7 +232,8 @@ double PbfSolver<Dim>::computeLambdas() {
       float gradientSquaredSum = 0;     // sum_j |grad W|^2, times (m / rho_0)^2 below
       float* factor = pairGradientFactors_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
-        const VecD r = pairOffset(i, *j, pi - p_[*j]);
+        VecD r = pi - p_[*j];
+        if (r.squaredNorm() <= coincidentLength_ * coincidentLength_) [[unlikely]] r = coincidentOffset(i, *j);
         const float r2 = r.squaredNorm();
         const auto k = kernels_.pair(r2);
         *factor++ = k.gradientFactor;
@@ -275,7 +277,8 @@ void PbfSolver<Dim>::applyPositionCorrections() {
       VecD delta = VecD::Zero();
       const float* factor = pairGradientFactors_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++factor) {
-        const VecD r = pairOffset(i, *j, pi - p_[*j]);
+        VecD r = pi - p_[*j];
+        if (r.squaredNorm() <= coincidentLength_ * coincidentLength_) [[unlikely]] r = coincidentOffset(i, *j);
         float coefficient = lambdaI + lambda_[*j];
         if (scorr && coefficient == 0.0f) {
           const float weight = kernels_.poly6(r.squaredNorm());
@@ -374,8 +377,7 @@ void PbfSolver<Dim>::applyXsphViscosity() {
 // would push their neighbours ever harder. Such a pair is given a tiny offset along a direction that depends on
 // the pair only and flips with its order (so momentum is still conserved).
 template <int Dim>
-typename PbfSolver<Dim>::VecD PbfSolver<Dim>::pairOffset(size_t i, size_t j, const VecD& r) const {
-  if (r.squaredNorm() > coincidentLength_ * coincidentLength_) return r;
+typename PbfSolver<Dim>::VecD PbfSolver<Dim>::coincidentOffset(size_t i, size_t j) const {
   const uint32_t lo = static_cast<uint32_t>(std::min(i, j)), hi = static_cast<uint32_t>(std::max(i, j));
   uint32_t hash = lo * 0x9E3779B1u ^ (hi + 0x7F4A7C15u) * 0x85EBCA77u;
   VecD direction;

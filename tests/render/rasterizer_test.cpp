@@ -80,6 +80,12 @@ TEST(RasterizerTest, ParticlesAndTwoDimensionalScenes) {
   const uint8_t* beside = pixelAt(image, 40, 20);
   EXPECT_GT(int(p[2]) - int(p[0]), 40);
   EXPECT_LT(std::abs(int(beside[2]) - int(beside[0])), 10);
+  // A 2D surface mesh (the surfacer extrudes it into a slab along z) is drawn face on the same way: a slab
+  // over x in [0.4, 0.6] covers the column at 80 x (0.04 + 0.92 x 0.25) = 21.6 from the floor to y = 0.5.
+  const Image slab = rasterizer.drawMesh(boxMesh({0.4f, 0.0f, -0.1f}, {0.6f, 0.5f, 0.1f}));
+  const uint8_t* inSlab = pixelAt(slab, 21, 30);
+  EXPECT_GT(int(inSlab[2]) - int(inSlab[0]), 40);
+  EXPECT_LT(std::abs(int(pixelAt(slab, 21, 5)[2]) - int(pixelAt(slab, 21, 5)[0])), 10);  // above the water
 }
 
 TEST(RasterizerTest, RenderFramesFallsBackToParticlesWithoutSurfaces) {
