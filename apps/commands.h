@@ -40,7 +40,9 @@ void addKeysCommand(CLI::App& app);
 // The stages, shared by their own subcommands and by `surge run`.
 void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const CommonOptions& options);
 void runSurfaceStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options);
-void runRenderStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options);
+// renderer: "embree", "gl", or empty for the default of the scene's dimension.
+void runRenderStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options,
+                    const std::string& renderer = "");
 void runVideoStage(const Scene& scene, const fs::path& dir, const CommonOptions& options);
 
 }  // namespace surge

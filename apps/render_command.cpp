@@ -24,8 +24,10 @@ void renderStage(const Scene& scene, const fs::path& dir, const FrameRange& rang
 }  // namespace
 
 void runRenderStage(const Scene& scene, const fs::path& dir, const FrameRange& range,
-                    const CommonOptions& options) {
-  renderStage(scene, dir, range, options, RenderOptions{});
+                    const CommonOptions& options, const std::string& renderer) {
+  RenderOptions renderOptions;
+  renderOptions.renderer = renderer;
+  renderStage(scene, dir, range, options, renderOptions);
 }
 
 void addRenderCommand(CLI::App& app) {
@@ -41,7 +43,7 @@ void addRenderCommand(CLI::App& app) {
   command->add_option("--frames", options->frames, "frames A:B (inclusive; either end may be left open)");
   command
       ->add_option("--renderer", options->render.renderer,
-                   "embree (path tracer, default) or gl (OSMesa preview)")
+                   "embree (path tracer; the default in 3D) or gl (OSMesa; the default in 2D)")
       ->check(CLI::IsMember({"embree", "gl"}));
   command->add_option("--quality", options->quality, "preview, standard or final (sets render.quality)")
       ->check(CLI::IsMember({"preview", "standard", "final"}));

@@ -7,11 +7,15 @@ namespace surge {
 void addRunCommand(CLI::App& app) {
   struct Options {
     CommonOptions common;
-    std::string scene;
+    std::string scene, renderer;
   };
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand("run", "simulate, surface, render and make the video of a scene");
   command->add_option("scene", options->scene, "scene file (JSON)")->required();
+  command
+      ->add_option("--renderer", options->renderer,
+                   "embree (path tracer; the default in 3D) or gl (OSMesa; the default in 2D)")
+      ->check(CLI::IsMember({"embree", "gl"}));
   addCommonOptions(*command, options->common, true);
   command->callback([options] {
     const Scene scene = loadScene(options->scene, options->common.overrides);
@@ -19,7 +23,7 @@ void addRunCommand(CLI::App& app) {
     const fs::path dir = outputFolder(options->common, scene);
     runSimStage(scene, dir, false, options->common);
     runSurfaceStage(scene, dir, FrameRange{}, options->common);
-    runRenderStage(scene, dir, FrameRange{}, options->common);
+    runRenderStage(scene, dir, FrameRange{}, options->common, options->renderer);
     runVideoStage(scene, dir, options->common);
   });
 }

@@ -110,9 +110,11 @@ Image renderMeshWith(const TriangleMesh& water, const Scene& scene, int frame, c
 
 void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress,
                   const RenderOptions& options) {
-  if (options.renderer != "embree" && options.renderer != "gl")
-    throw InputError(dir.string(), "--renderer", "unknown renderer '" + options.renderer + "' (embree, gl)");
-  const bool gl = options.renderer == "gl";
+  // No renderer named: the path tracer for 3D scenes, the clean 2D view of the rasteriser for 2D ones.
+  const std::string renderer = options.renderer.empty() ? (scene.dimensions == 2 ? "gl" : "embree") : options.renderer;
+  if (renderer != "embree" && renderer != "gl")
+    throw InputError(dir.string(), "--renderer", "unknown renderer '" + renderer + "' (embree, gl)");
+  const bool gl = renderer == "gl";
   std::vector<int> all = listFrames(dir, "surface", "ply");
   const bool particles = gl && (options.particles || all.empty());
   if (particles) all = listFrames(dir, "particles", "ply");

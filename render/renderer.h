@@ -38,7 +38,7 @@ Image renderMeshWith(const TriangleMesh& water, const Scene& scene, int frame, c
                      RenderStats* stats = nullptr);
 
 struct RenderOptions {
-  std::string renderer = "embree";  // "embree" (path tracer) or "gl" (OSMesa rasteriser)
+  std::string renderer;  // "embree" (path tracer), "gl" (OSMesa rasteriser), or empty: embree in 3D, gl in 2D
   bool particles = false;           // gl: draw particles/frame_NNNNN.ply as spheres instead of the surface
 };
 

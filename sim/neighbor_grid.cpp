@@ -80,11 +80,13 @@ void NeighborGrid<Dim>::sort(const std::vector<Vec<Dim>>& positions) {
     parallelFor(0, n, [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) cellOfParticle_[i] = static_cast<uint32_t>(linearIndex(cellCoordinates(positions[i])));
     });
-    cellStart_.assign(cells + 1, 0);
-    for (size_t i = 0; i < n; ++i) ++cellStart_[cellOfParticle_[i] + 1];
-    for (size_t c = 1; c < cellStart_.size(); ++c) cellStart_[c] += cellStart_[c - 1];
-    cursor_.assign(cellStart_.begin(), cellStart_.end() - 1);
-    for (size_t i = 0; i < n; ++i) order_[cursor_[cellOfParticle_[i]]++] = static_cast<uint32_t>(i);
+    // Counts go two places up, so that after the prefix sum cellStart_[c + 1] is where cell c starts; placing
+    // the particles advances it to where cell c ends, which is where cell c + 1 starts: the array ends up as
+    // the cells' starts with no second cursor array.
+    cellStart_.assign(cells + 2, 0);
+    for (size_t i = 0; i < n; ++i) ++cellStart_[cellOfParticle_[i] + 2];
+    for (size_t c = 2; c < cellStart_.size(); ++c) cellStart_[c] += cellStart_[c - 1];
+    for (size_t i = 0; i < n; ++i) order_[cellStart_[cellOfParticle_[i] + 1]++] = static_cast<uint32_t>(i);
     return;
   }
   cellOfParticle_.clear();

@@ -71,13 +71,12 @@ class NeighborGrid {
   Cell resolution_;
   uint64_t cellCount_ = 0;
   bool sparse_ = false;
-  std::vector<uint32_t> cellStart_;    // dense: per cell, its first slot (plus one entry at the end)
+  std::vector<uint32_t> cellStart_;    // dense: per cell, its first slot (and past the last cell, the end)
   std::vector<uint64_t> cellKeys_;     // sparse: the occupied cells' linear indices, ascending
   std::vector<uint32_t> sparseStart_;  // sparse: per occupied cell, its first slot (plus one at the end)
   std::vector<uint32_t> cellOfParticle_;  // dense: each particle's cell
   std::vector<uint64_t> keyOfParticle_;   // sparse: each particle's 64-bit cell key
   std::vector<uint32_t> order_;
-  std::vector<uint32_t> cursor_;
 };
 
 // Applies a permutation: values[k] = old values[order[k]], in parallel. Used to reorder every particle channel.

@@ -47,6 +47,20 @@ double latticeVariance(double spacing, double radius) {
   return sumX2 / sum;
 }
 
+// Sum over the infinite rest lattice of `spacing` of the poly6 kernel of support h, sigma / h^3 P(|r| / h)
+// with P(q) = (1 - q^2)^3 and sigma = 315 / (64 pi): about 1 / spacing^3.
+double latticeKernelSum(double spacing, double h) {
+  const int n = int(std::ceil(h / spacing));
+  double sum = 0;
+  for (int i = -n; i <= n; ++i)
+    for (int j = -n; j <= n; ++j)
+      for (int k = -n; k <= n; ++k) {
+        const double q2 = spacing * spacing * double(i * i + j * j + k * k) / (h * h);
+        if (q2 < 1) sum += (1 - q2) * (1 - q2) * (1 - q2);
+      }
+  return sum * 315 / (64 * 3.14159265358979323846 * h * h * h);
+}
+
 // A uniform grid of cells of side >= radius over the particles' bounding box, particles counting-sorted by
 // cell: neighbours within `radius` lie in the 27 cells around a particle's own.
 struct CellGrid {
@@ -157,6 +171,7 @@ AnisotropicKernels anisotropicKernels(const std::vector<Eigen::Vector3f>& x, con
     }
   });
   out.maxExtent = double(*std::max_element(extent.begin(), extent.end()));
+  out.particleVolume = 1 / latticeKernelSum(p.spacing, h);
   return out;
 }
 

@@ -191,9 +191,17 @@ BlockField rasterizeField(const FieldParticles& particles, const FieldParameters
                       s[0] += w, s[1] += w * x.x(), s[2] += w * x.y(), s[3] += w * x.z();
                       break;
                     }
-                    case FieldKind::Anisotropic:
-                      acc[a] += scale * zbKernel((*G * d).squaredNorm());
+                    case FieldKind::Anisotropic: {
+                      // f and its gradient: grad_x P(|G d|^2) = -6 (1 - q^2)^2 G^T G d, and G is symmetric.
+                      const Eigen::Vector3f u = *G * d;
+                      const float q2 = u.squaredNorm();
+                      if (q2 >= 1) break;
+                      const float w = 1 - q2;
+                      const Eigen::Vector3f g = (-6 * scale * w * w) * (*G * u);
+                      float* s = &acc[4 * a];
+                      s[0] += scale * w * w * w, s[1] += g.x(), s[2] += g.y(), s[3] += g.z();
                       break;
+                    }
                     case FieldKind::Velocity: {
                       const float w = zbKernel(d.squaredNorm() * invR2);
                       float* s = &acc[4 * a];
@@ -223,9 +231,15 @@ BlockField rasterizeField(const FieldParticles& particles, const FieldParameters
                 phi = (Eigen::Vector3f(float(ix * v), float(iy * v), float(iz * v)) - xbar).norm() - r;
                 break;
               }
-              case FieldKind::Anisotropic:
-                phi = float((p.iso - acc[a]) * p.distanceScale);
+              case FieldKind::Anisotropic: {
+                // First-order distance to the iso-surface, (iso - f) / |grad f|: exact at the crossing, which
+                // is all the re-distancing needs; +-band where f is flat (far outside, or deep inside).
+                const float* s = &acc[4 * a];
+                const float gradient = Eigen::Vector3f(s[1], s[2], s[3]).norm();
+                const float offset = float(p.iso) - s[0];
+                phi = std::abs(offset) < band * gradient ? offset / gradient : (offset < 0 ? -band : band);
                 break;
+              }
               case FieldKind::Velocity: {
                 const float* s = &acc[4 * a];
                 for (int k = 0; k < 3; ++k) values[3 * a + k] = s[0] > 0 ? s[k + 1] / s[0] : 0.f;

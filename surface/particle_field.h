@@ -45,7 +45,6 @@ struct FieldParameters {
   double band = 0;      // distances are clamped to +-band; blocks with no voxel inside (-band, band) are dropped
   double iso = 0.5;     // Anisotropic: the surface is f = iso
   double volume = 0;    // Anisotropic: V
-  double distanceScale = 0;  // Anisotropic: world units per unit of f near the surface
   // Distance fields: a block is taken as wholly inside, and skipped, when every cell of this size within
   // `support + band` of it holds a particle (0: never skip). Cells of 2 spacings hold 8 particles at rest.
   double occupancyCell = 0;

@@ -19,6 +19,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <mutex>
@@ -72,7 +73,7 @@ constexpr double kZbInset = 0.0;
 constexpr double kAnisoSupport = 2.0;
 constexpr double kAnisoPca = 3.0;
 constexpr double kAnisoIso = 0.5;
-constexpr double kAnisoInset = 0.0;
+constexpr double kAnisoInset = 0.753;
 
 FloatGrid::Ptr emptyLevelSet(double voxel) {
   FloatGrid::Ptr grid = openvdb::createLevelSet<FloatGrid>(voxel, kHalfWidthVoxels);
@@ -164,10 +165,7 @@ FloatGrid::Ptr rawLevelSet(const ParticleFrame& frame, const Parameters& p) {
     particles.kernels = &kernels;
     f.kind = FieldKind::Anisotropic;
     f.iso = kAnisoIso;
-    f.volume = p.spacing * p.spacing * p.spacing;
-    // Inside a fluid at rest f = 1: (1 - iso) * scale must exceed the band, so that blocks wholly inside are
-    // recognised as such and never built.
-    f.distanceScale = 1.2 * band / (1 - kAnisoIso);
+    f.volume = kernels.particleVolume;
   } else {
     throw RunError("surface: unknown surface.method \"" + p.method + "\"");
   }
@@ -210,10 +208,13 @@ FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
   // crossing outward, and trims it back to the narrow band. (tools::sdfToSdf, fast sweeping, did the same
   // here first and took 90% of the time: 85 s for a million particles, against 1.5 s for this.)
   openvdb::tools::LevelSetFilter<FloatGrid, FloatGrid, CtrlCInterrupter> filter(*grid, &interrupter);
-  filter.setNormCount(kRenormalise);
+  const auto knob = [](const char* name, int fallback) { const char* v = std::getenv(name); return v ? std::atoi(v) : fallback; };
+  if (knob("SURGE_FIRST", 0)) filter.setSpatialScheme(openvdb::math::FIRST_BIAS);
+  filter.setNormCount(knob("SURGE_NORM0", kRenormalise));
   filter.normalize();
   filter.prune();  // voxels now beyond the band become inactive background
   Progress::checkInterrupt();
+  filter.setNormCount(knob("SURGE_NORMK", kRenormalise));
 
   // Smooth first, erode second: mean-curvature flow fills the dents between the spheres and rounds the sphere
   // caps, the erosion then takes the surface back to the fluid. (Eroding first would leave a lone particle
@@ -221,7 +222,15 @@ FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
   for (int i = 0; i < scene.surface.smoothing_steps; ++i) filter.meanCurvature();
   // Positive offsets shrink the level set (phi + offset, phi < 0 inside).
   const double erosion = erosionOf(p);
-  if (erosion != 0) filter.offset(float(erosion));
+  if (erosion != 0 && knob("SURGE_EXACT", 0)) {
+    openvdb::tree::LeafManager<FloatGrid::TreeType> leaves(grid->tree());
+    const float c = float(erosion);
+    leaves.foreach([c](FloatGrid::TreeType::LeafNodeType& leaf, size_t) {
+      for (auto it = leaf.beginValueOn(); it; ++it) it.setValue(*it + c);
+    });
+    const int tracks = int(std::ceil(std::abs(erosion) / p.voxel - 1e-9));
+    for (int i = 0; i < tracks; ++i) filter.track();
+  } else if (erosion != 0) filter.offset(float(erosion));
   Progress::checkInterrupt();
   return grid;
 }
