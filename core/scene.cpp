@@ -356,6 +356,18 @@ void validate(Scene& s, const std::string& where) {
     if ((s.domain.max[k] - s.domain.min[k]) / solver.kernel_radius > double(1 << 20))
       throw InputError(where, "domain", "spans more than 2^20 kernel radii along an axis");
 
+  if (solver.speed_of_sound == 0) {
+    // Ten times the fastest the water can move by falling through the tank (or by its initial velocity):
+    // density then varies by about 1% (Monaghan 1994).
+    double speed = std::sqrt(2 * s.gravity.norm() * (s.domain.max - s.domain.min)[1]);
+    for (const FluidBlock& fluid : s.fluids) speed = std::max(speed, fluid.velocity.norm());
+    solver.speed_of_sound = 10 * std::max(speed, 1.0);
+  }
+  if (solver.gas_constant == 0) solver.gas_constant = solver.speed_of_sound * solver.speed_of_sound;
+  for (size_t i = 1; i < s.attractor.keyframes.size(); ++i)
+    if (s.attractor.keyframes[i].time < s.attractor.keyframes[i - 1].time)
+      throw InputError(where, "attractor.keyframes[" + std::to_string(i) + "].time", "keyframes must be in time order");
+
   SurfaceSettings& surface = s.surface;
   if (surface.particle_radius == 0) surface.particle_radius = spacing;
   if (surface.voxel_size == 0) surface.voxel_size = surface.particle_radius / 2;

@@ -35,6 +35,30 @@ struct SolverSettings {
   double scorr_delta_q = 0.2;  // as a fraction of the kernel radius
   double vorticity_epsilon = 0;  // vorticity confinement (eq. 15-16); 0 turns it off
   double xsph_c = 0.01;          // XSPH viscosity (eq. 17); 0 turns it off
+  // Weakly compressible SPH (solver.method "wcsph"); see sim/wcsph_solver.h.
+  std::string kernel = "cubic_spline";   // or "wendland_c2"
+  std::string equation_of_state = "tait";  // or "linear" (the gas law k (rho - rho_0))
+  double speed_of_sound = 0;             // 0 in the file: 10 x the speed of a fall through the tank (resolved)
+  double gas_constant = 0;               // linear law's k; 0 in the file: speed_of_sound^2 (resolved)
+  std::string integrator = "velocity_verlet";  // or "symplectic_euler"
+  double time_step = 0;                  // > 0: a fixed step; 0: from the CFL, viscous and force limits
+  double cfl = 0.4;
+  double artificial_viscosity = 0.05;    // Monaghan's alpha; 0 turns it off
+  double kinematic_viscosity = 0;        // laminar nu (m^2/s); 0 turns it off
+  double near_pressure = 0;              // Clavet et al. 2005 near-pressure stiffness; 0 turns it off
+};
+
+struct AttractorKeyframe {
+  double time = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+};
+
+// A point that moves along keyframes and pulls (strength > 0) or pushes particles within its radius, as the
+// SPH demo's mouse did. No keyframes: no attractor.
+struct AttractorSettings {
+  double radius = 0.2;
+  double strength = 20;
+  std::vector<AttractorKeyframe> keyframes;
 };
 
 struct OutputSettings {
@@ -83,6 +107,7 @@ struct Scene {
   double particle_spacing = 0;
   std::vector<FluidBlock> fluids;
   Eigen::Vector3d gravity = Eigen::Vector3d(0, -9.81, 0);
+  AttractorSettings attractor;
   SolverSettings solver;
   OutputSettings output;
   SurfaceSettings surface;

@@ -58,10 +58,25 @@ void visitScene(Scene& s, SceneVisitor& v) {
         v.vector("velocity", f.velocity, info("initial velocity", "m/s"));
       });
   v.vector("gravity", s.gravity, info("gravitational acceleration", "m/s^2"));
+  v.group("attractor", info("a point moving along keyframes that pulls (or pushes) particles near it"), [&] {
+    v.real("radius", s.attractor.radius, positive("particles closer than this feel it", "m"));
+    v.real("strength", s.attractor.strength,
+           info("acceleration at its centre, falling linearly to 0 at the radius; negative pushes", "m/s^2"));
+    v.list(
+        "keyframes", info("times and positions, linearly interpolated (held before the first and after the last)"),
+        [&] { return s.attractor.keyframes.size(); }, [&](size_t n) { s.attractor.keyframes.resize(n); },
+        [&](size_t i) {
+          v.real("time", s.attractor.keyframes[i].time, atLeast(0, "time of the keyframe", "s"));
+          v.vector("position", s.attractor.keyframes[i].position, required("position at that time", "m"));
+        });
+  });
 
   v.group("solver", info("the simulator"), [&] {
-    v.choice("method", s.solver.method, {"pbf"}, info("pbf: Position Based Fluids (Macklin & Mueller 2013)"));
-    v.integer("substeps", s.solver.substeps, atLeast(1, "time steps per output frame", "", 100000));
+    v.choice("method", s.solver.method, {"pbf", "wcsph"},
+             info("pbf: Position Based Fluids (Macklin & Mueller 2013); wcsph: weakly compressible SPH "
+                  "(Monaghan 1994, Becker & Teschner 2007)"));
+    v.integer("substeps", s.solver.substeps,
+              atLeast(1, "PBF: time steps per output frame (WCSPH chooses its own, see time_step)", "", 100000));
     v.integer("iterations", s.solver.iterations, atLeast(1, "PBF: Jacobi iterations per step", "", 10000));
     v.real("kernel_radius", s.solver.kernel_radius,
            atLeast(0, "SPH kernel radius h; 0 means 2 x particle_spacing", "m"));
@@ -84,6 +99,29 @@ void visitScene(Scene& s, SceneVisitor& v) {
            atLeast(0, "PBF eq. 16 vorticity confinement epsilon; 0 turns it off", "m/s"));
     v.real("xsph_c", s.solver.xsph_c,
            atLeast(0, "PBF eq. 17 XSPH viscosity c (weights scaled by the particle volume); 0 turns it off", "", 1));
+    v.choice("kernel", s.solver.kernel, {"cubic_spline", "wendland_c2"},
+             info("WCSPH smoothing kernel, support kernel_radius: cubic spline (Monaghan 1992) or Wendland C2"));
+    v.choice("equation_of_state", s.solver.equation_of_state, {"tait", "linear"},
+             info("WCSPH: tait, p = rho_0 c^2 / 7 ((rho / rho_0)^7 - 1); linear, p = k (rho - rho_0); negative "
+                  "pressures are clamped to 0"));
+    v.real("speed_of_sound", s.solver.speed_of_sound,
+           atLeast(0, "WCSPH speed of sound c; 0 means 10 x the speed of a fall through the tank's height", "m/s"));
+    v.real("gas_constant", s.solver.gas_constant,
+           atLeast(0, "WCSPH linear law's k; 0 means speed_of_sound^2", "m^2/s^2"));
+    v.choice("integrator", s.solver.integrator, {"velocity_verlet", "symplectic_euler"},
+             info("WCSPH time integration: velocity Verlet (kick-drift-kick) or semi-implicit Euler"));
+    v.real("time_step", s.solver.time_step,
+           atLeast(0, "WCSPH: a fixed step; 0 chooses each step from the CFL, viscous and force limits", "s"));
+    FieldInfo cfl = positive("WCSPH Courant number: dt <= cfl h / (c + |v|max), h = kernel_radius / 2");
+    cfl.max = 1;
+    v.real("cfl", s.solver.cfl, cfl);
+    v.real("artificial_viscosity", s.solver.artificial_viscosity,
+           atLeast(0, "WCSPH: Monaghan's artificial viscosity alpha; 0 turns it off"));
+    v.real("kinematic_viscosity", s.solver.kinematic_viscosity,
+           atLeast(0, "WCSPH: laminar viscosity nu (Morris 1997); 0 turns it off", "m^2/s"));
+    v.real("near_pressure", s.solver.near_pressure,
+           atLeast(0, "WCSPH: near-pressure stiffness of Clavet et al. 2005's double density relaxation, as a "
+                      "force; keeps surface particles apart; 0 turns it off", "m^2/s^2"));
   });
   v.group("output", info("what the simulator writes"), [&] {
     v.real("fps", s.output.fps, positive("output frames per simulated second (and the video's frame rate)"));

@@ -68,4 +68,62 @@ class Kernels {
   float poly6_, spiky_;
 };
 
+// The kernels of the weakly compressible solver, with support H (the scene's kernel_radius), q = r / H:
+//   cubic spline (Monaghan 1992, in the form of SPlisHSPlasH): 6 (q^3 - q^2) + 1 for q <= 1/2, 2 (1 - q)^3 for
+//     q <= 1, times 8 / (pi H^3) in 3D and 40 / (7 pi H^2) in 2D;
+//   Wendland C2 (Wendland 1995): (1 - q)^4 (1 + 4 q), times 21 / (2 pi H^3) in 3D and 7 / (pi H^2) in 2D.
+// value(r) is W; gradientFactor(r) is g with grad_{p_i} W(p_i - p_j) = g (p_i - p_j), zero at r = 0.
+template <int Dim>
+class CubicSplineKernel {
+ public:
+  explicit CubicSplineKernel(float support)
+      : support_(support),
+        inverseSupport_(1.0f / support),
+        sigma_(static_cast<float>(Dim == 3 ? 8.0 / (M_PI * std::pow(double(support), 3))
+                                           : 40.0 / (7.0 * M_PI * double(support) * support))) {}
+  float radius() const { return support_; }
+  float value(float r) const {
+    const float q = r * inverseSupport_;
+    if (q >= 1.0f) return 0.0f;
+    if (q <= 0.5f) return sigma_ * (6.0f * (q * q * q - q * q) + 1.0f);
+    const float d = 1.0f - q;
+    return sigma_ * 2.0f * d * d * d;
+  }
+  float gradientFactor(float r) const {
+    const float q = r * inverseSupport_;
+    if (q >= 1.0f || r <= 1e-12f) return 0.0f;
+    const float dWdq = q <= 0.5f ? 6.0f * q * (3.0f * q - 2.0f) : -6.0f * (1.0f - q) * (1.0f - q);
+    return sigma_ * dWdq * inverseSupport_ / r;
+  }
+
+ private:
+  float support_, inverseSupport_, sigma_;
+};
+
+template <int Dim>
+class WendlandC2Kernel {
+ public:
+  explicit WendlandC2Kernel(float support)
+      : support_(support),
+        inverseSupport_(1.0f / support),
+        sigma_(static_cast<float>(Dim == 3 ? 21.0 / (2.0 * M_PI * std::pow(double(support), 3))
+                                           : 7.0 / (M_PI * double(support) * support))) {}
+  float radius() const { return support_; }
+  float value(float r) const {
+    const float q = r * inverseSupport_;
+    if (q >= 1.0f) return 0.0f;
+    const float d = 1.0f - q;
+    return sigma_ * d * d * d * d * (1.0f + 4.0f * q);
+  }
+  float gradientFactor(float r) const {
+    const float q = r * inverseSupport_;
+    if (q >= 1.0f || r <= 1e-12f) return 0.0f;
+    const float d = 1.0f - q;
+    return sigma_ * (-20.0f * q * d * d * d) * inverseSupport_ / r;
+  }
+
+ private:
+  float support_, inverseSupport_, sigma_;
+};
+
 }  // namespace surge

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/parallel.h"
+#include "sim/tank.h"
 
 namespace surge {
 namespace {
@@ -29,37 +30,26 @@ Vec<Dim> toVec(const Eigen::Vector3d& v) {
 }  // namespace
 
 template <int Dim>
-void restLatticeSums(const Kernels<Dim>& kernels, float spacing, double* weightSum, double* gradientSquaredSum) {
-  const int reach = static_cast<int>(std::ceil(kernels.radius() / spacing));
-  double w = 0, g = 0;
-  const int zReach = Dim == 3 ? reach : 0;
-  for (int i = -reach; i <= reach; ++i)
-    for (int j = -reach; j <= reach; ++j)
-      for (int k = -zReach; k <= zReach; ++k) {
-        Vec<Dim> r;
-        r[0] = i * spacing;
-        r[1] = j * spacing;
-        if constexpr (Dim == 3) r[2] = k * spacing;
-        w += kernels.poly6(r.squaredNorm());
-        g += kernels.spikyGradient(r, r.norm()).squaredNorm();
-      }
-  *weightSum = w;
-  *gradientSquaredSum = g;
-}
-
-template <int Dim>
 PbfSolver<Dim>::PbfSolver(const Scene& scene)
     : kernels_(static_cast<float>(scene.solver.kernel_radius)),
+      attractor_(scene.attractor),
       // Cells of half the kernel radius: searching 5 cells a side reads fewer candidates than 3 of the radius.
       grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
-            static_cast<float>(0.5 * scene.solver.kernel_radius)) {
+            static_cast<float>(0.5 * scene.solver.kernel_radius)),
+      walls_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max), static_cast<float>(scene.particle_spacing),
+             static_cast<float>(scene.solver.kernel_radius),
+             [&](const VecD& r) { return kernels_.poly6(r.squaredNorm()); },
+             [&](const VecD& r) { return kernels_.spikyGradient(r, r.norm()); }) {
+  substeps_ = scene.solver.substeps;
   const SolverSettings& s = scene.solver;
   const float spacing = static_cast<float>(scene.particle_spacing);
   restDensity_ = static_cast<float>(s.rest_density);
   // The mass makes an interior particle of the rest lattice have exactly rho_0 (eq. 2 summed over the lattice),
   // so a block at rest starts unstressed and keeps its volume N x spacing^d.
   double weightSum = 0, gradientSquaredSum = 0;
-  restLatticeSums(kernels_, spacing, &weightSum, &gradientSquaredSum);
+  latticeSums<Dim>(spacing, kernels_.radius(), [&](const VecD& r) { return kernels_.poly6(r.squaredNorm()); },
+                   [&](const VecD& r) { return kernels_.spikyGradient(r, r.norm()); }, &weightSum,
+                   &gradientSquaredSum);
   mass_ = static_cast<float>(s.rest_density / weightSum);
   massOverRho_ = mass_ / restDensity_;
   // sum_k |grad_k C_i|^2 at the rest lattice (eq. 8-9 with C_i = rho_i / rho_0 - 1): the scale of eq. 11's
@@ -77,53 +67,6 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene)
   iterations_ = s.iterations;
   maxDensityError_ = s.max_density_error;
   gravity_ = toVec<Dim>(scene.gravity);
-  domainMin_ = toVec<Dim>(scene.domain.min);
-  domainMax_ = toVec<Dim>(scene.domain.max);
-  // Collision response keeps particle centres a particle radius inside the walls.
-  const float particleRadius = 0.5f * spacing;
-  wallMin_ = domainMin_ + VecD::Constant(particleRadius);
-  wallMax_ = domainMax_ - VecD::Constant(particleRadius);
-
-  // Wall boundary: a particle at distance d from a wall sees the rest lattice continued beyond the wall, its
-  // layers at d + spacing / 2 + k spacing, tangentially aligned with the particle. So a particle of the rest
-  // lattice next to a wall has rho_0 as an interior one does, and is pushed off the wall by its own constraint
-  // instead of piling up against it (after the boundary particles of Akinci et al. 2012, summed once here).
-  const float h = kernels_.radius();
-  const int reach = static_cast<int>(std::ceil(h / spacing)) + 1;
-  wallWeight_.assign(kWallTableSize + 1, 0.0f);
-  wallGradient_.assign(kWallTableSize + 1, 0.0f);
-  wallTableScale_ = kWallTableSize / h;
-  for (int t = 0; t <= kWallTableSize; ++t) {
-    const float d = h * t / kWallTableSize;
-    double weight = 0, gradient = 0;
-    for (int layer = 0; layer <= reach; ++layer)
-      for (int a = -reach; a <= reach; ++a)
-        for (int b = (Dim == 3 ? -reach : 0); b <= (Dim == 3 ? reach : 0); ++b) {
-          VecD r = VecD::Zero();  // p_i - p_b with the wall normal along axis 0
-          r[0] = d + 0.5f * spacing + layer * spacing;
-          r[1] = a * spacing;
-          if constexpr (Dim == 3) r[2] = b * spacing;
-          weight += kernels_.poly6(r.squaredNorm());
-          gradient += kernels_.spikyGradient(r, r.norm())[0];  // <= 0: towards the wall
-        }
-    wallWeight_[t] = static_cast<float>(weight);
-    wallGradient_[t] = static_cast<float>(-gradient);
-  }
-}
-
-template <int Dim>
-void PbfSolver<Dim>::addWallTerms(const VecD& p, float& weight, VecD& gradient) const {
-  for (int k = 0; k < Dim; ++k)
-    for (int side = 0; side < 2; ++side) {
-      const float d = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
-      const float u = std::max(d, 0.0f) * wallTableScale_;
-      if (!(u < kWallTableSize)) continue;  // also skips NaN
-      const int t = static_cast<int>(u);
-      const float f = u - t;
-      weight += (1 - f) * wallWeight_[t] + f * wallWeight_[t + 1];
-      const float g = (1 - f) * wallGradient_[t] + f * wallGradient_[t + 1];
-      gradient[k] += side == 0 ? -g : g;  // grad_{p_i} points towards the wall
-    }
 }
 
 template <int Dim>
@@ -156,25 +99,29 @@ void PbfSolver<Dim>::getParticles(ParticleFrame& frame) const {
 }
 
 template <int Dim>
-long PbfSolver<Dim>::step(float dt) {
-  predictPositions(dt);
+long PbfSolver<Dim>::step(float dt, double time) {
+  predictPositions(dt, time);
   findNeighbors();
   solveDensityConstraints();
   updateVelocities(dt);
   if (vorticityEpsilon_ > 0) applyVorticityConfinement(dt);
   if (xsphC_ > 0) applyXsphViscosity();
   x_.swap(p_);  // line 23: x_i = x*_i
-  return firstBadParticle();
+  return firstParticleOutside(x_, v_, walls_);
 }
 
-// Algorithm 1, lines 1-4: v_i += dt f_ext(x_i); x*_i = x_i + dt v_i. The walls act on x* at once.
+// Algorithm 1, lines 1-4: v_i += dt f_ext(x_i); x*_i = x_i + dt v_i. The walls act on x* at once. External
+// forces: gravity, and the attractor when the scene has one.
 template <int Dim>
-void PbfSolver<Dim>::predictPositions(float dt) {
+void PbfSolver<Dim>::predictPositions(float dt, double time) {
+  const bool attract = attractor_.active();
+  const VecD attractorAt = attract ? attractor_.position(time) : VecD::Zero();
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       v_[i] += dt * gravity_;
+      if (attract) v_[i] += dt * attractor_.acceleration(x_[i], attractorAt);
       p_[i] = x_[i] + dt * v_[i];
-      clampToWalls(p_[i]);
+      walls_.clamp(p_[i]);
     }
   });
 }
@@ -244,7 +191,7 @@ double PbfSolver<Dim>::computeLambdas() {
       VecD gradientI = massOverRho_ * gradientSum;
       gradientSquaredSum *= massOverRho_ * massOverRho_;
       VecD wallGradient = VecD::Zero();
-      addWallTerms(p_[i], weight, wallGradient);
+      walls_.add(p_[i], weight, wallGradient);
       gradientI += massOverRho_ * wallGradient;
       const float constraint = std::max(mass_ * weight / restDensity_ - 1.0f, 0.0f);
       lambda_[i] = -constraint / (gradientSquaredSum + gradientI.squaredNorm() + epsilon_);
@@ -289,7 +236,7 @@ void PbfSolver<Dim>::applyPositionCorrections() {
       // The walls do not move and carry no constraint of their own: only lambda_i acts along their gradient.
       float unusedWeight = 0;
       VecD wallGradient = VecD::Zero();
-      addWallTerms(p_[i], unusedWeight, wallGradient);
+      walls_.add(p_[i], unusedWeight, wallGradient);
       delta += lambda_[i] * wallGradient;
       scratch_[i] = massOverRho_ * delta;
     }
@@ -297,7 +244,7 @@ void PbfSolver<Dim>::applyPositionCorrections() {
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       p_[i] += scratch_[i];
-      clampToWalls(p_[i]);
+      walls_.clamp(p_[i]);
     }
   });
 }
@@ -390,74 +337,18 @@ typename PbfSolver<Dim>::VecD PbfSolver<Dim>::coincidentOffset(size_t i, size_t 
   return (i < j ? coincidentLength_ : -coincidentLength_) * direction.normalized();
 }
 
-// Collision response with the tank: positions are projected back inside. NaN stays NaN (comparisons with NaN
-// are false), so a diverged particle is reported instead of being hidden at a wall.
-template <int Dim>
-void PbfSolver<Dim>::clampToWalls(VecD& p) const {
-  for (int k = 0; k < Dim; ++k) p[k] = p[k] < wallMin_[k] ? wallMin_[k] : (p[k] > wallMax_[k] ? wallMax_[k] : p[k]);
-}
-
-template <int Dim>
-long PbfSolver<Dim>::firstBadParticle() const {
-  struct First {
-    long index = -1;
-    First& operator+=(const First& o) {
-      if (index < 0 || (o.index >= 0 && o.index < index)) index = o.index;
-      return *this;
-    }
-  };
-  return parallelSum<First>(0, size(), [&](size_t b, size_t e) {
-           First first;
-           for (size_t i = b; i < e && first.index < 0; ++i) {
-             const bool finite = x_[i].allFinite() && v_[i].allFinite();
-             const bool inside =
-                 (x_[i].array() >= domainMin_.array()).all() && (x_[i].array() <= domainMax_.array()).all();
-             if (!finite || !inside) first.index = static_cast<long>(i);
-           }
-           return first;
-         }).index;
-}
-
 // Density error of DESIGN.md at the current positions, with the neighbour lists of the last step.
 template <int Dim>
 FluidMeasures PbfSolver<Dim>::measure() {
-  struct Sums {
-    double errorSum = 0, errorMax = 0, energy = 0;
-    Sums& operator+=(const Sums& o) {
-      errorSum += o.errorSum;
-      errorMax = std::max(errorMax, o.errorMax);
-      energy += o.energy;
-      return *this;
-    }
-  };
   if (neighbors_.size() != size()) {
     p_ = x_;  // before the first step: neighbours of the current positions
     findNeighbors();
   }
-  const float selfWeight = kernels_.poly6(0.0f);
-  const Sums sums = parallelSum<Sums>(0, size(), [&](size_t b, size_t e) {
-    Sums s;
-    for (size_t i = b; i < e; ++i) {
-      float weight = selfWeight;
-      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j)
-          weight += kernels_.poly6((x_[i] - x_[*j]).squaredNorm());
-      const double error = std::max(double(mass_ * weight / restDensity_) - 1.0, 0.0);
-      s.errorSum += error;
-      s.errorMax = std::max(s.errorMax, error);
-      s.energy += 0.5 * mass_ * v_[i].squaredNorm();
-    }
-    return s;
-  });
-  FluidMeasures m;
-  m.densityErrorAvg = size() ? sums.errorSum / double(size()) : 0;
-  m.densityErrorMax = sums.errorMax;
-  m.kineticEnergy = sums.energy;
-  return m;
+  return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, walls_, mass_, restDensity_,
+                                      [&](float r2) { return kernels_.poly6(r2); });
 }
 
 template class PbfSolver<2>;
 template class PbfSolver<3>;
-template void restLatticeSums(const Kernels<2>&, float, double*, double*);
-template void restLatticeSums(const Kernels<3>&, float, double*, double*);
 
 }  // namespace surge

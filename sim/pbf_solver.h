@@ -12,25 +12,19 @@
 // no memory.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "core/ply.h"
 #include "core/scene.h"
+#include "sim/attractor.h"
 #include "sim/kernels.h"
+#include "sim/measures.h"
 #include "sim/neighbor_grid.h"
+#include "sim/tank.h"
 
 namespace surge {
-
-// Milliseconds spent per phase, accumulated until reset.
-struct PhaseTimes {
-  double neighbors = 0, constraint = 0, vorticity = 0, viscosity = 0;
-};
-
-// Density error as DESIGN.md defines it (compression only, as a fraction of rho_0) and kinetic energy.
-struct FluidMeasures {
-  double densityErrorAvg = 0, densityErrorMax = 0, kineticEnergy = 0;
-};
 
 template <int Dim>
 class PbfSolver {
@@ -43,9 +37,15 @@ class PbfSolver {
   void getParticles(ParticleFrame& frame) const;
   size_t size() const { return x_.size(); }
 
-  // One time step of Algorithm 1. Returns the index of the first particle whose state is not finite or lies
-  // outside the domain afterwards, or -1 if all are well.
-  long step(float dt);
+  // The frame loop's interface (see sim/simulation.cpp): PBF takes the scene's substeps a frame.
+  int fixedSubsteps() const { return substeps_; }
+  void beginFrame(double) {}
+  float stableTimeStep() const { return INFINITY; }
+  float maxPressure() const { return NAN; }  // PBF has no pressure
+
+  // One time step of Algorithm 1 from `time` (which moves the attractor). Returns the index of the first
+  // particle whose state is not finite or lies outside the domain afterwards, or -1 if all are well.
+  long step(float dt, double time = 0);
 
   FluidMeasures measure();
   int lastIterations() const { return lastIterations_; }
@@ -55,7 +55,7 @@ class PbfSolver {
   const std::vector<VecD>& positions() const { return x_; }
 
  private:
-  void predictPositions(float dt);
+  void predictPositions(float dt, double time);
   void findNeighbors();
   void solveDensityConstraints();
   double computeLambdas();  // returns the average density error before this iteration's correction
@@ -63,13 +63,11 @@ class PbfSolver {
   void updateVelocities(float dt);
   void applyVorticityConfinement(float dt);
   void applyXsphViscosity();
-  void clampToWalls(VecD& p) const;
   // The offset p_i - p_j used for a pair closer than coincidentLength_ (see the .cpp).
   VecD coincidentOffset(size_t i, size_t j) const;
   // Adds the walls' share of eq. 2 and eq. 8 for a particle at p: to the kernel weight sum and to
   // sum_j grad W (both before the factor m or m / rho_0).
   void addWallTerms(const VecD& p, float& weight, VecD& gradient) const;
-  long firstBadParticle() const;
 
   // Parameters, fixed at construction.
   Kernels<Dim> kernels_;
@@ -80,12 +78,9 @@ class PbfSolver {
   float vorticityEpsilon_, xsphC_;
   int iterations_;
   double maxDensityError_;
-  VecD gravity_, wallMin_, wallMax_, domainMin_, domainMax_;
-  // The walls as the rest lattice continued beyond them, tabulated against the distance d to the wall
-  // plane in kWallTableSize steps over [0, h]: sum of W, and the normal component of sum of grad W.
-  static constexpr int kWallTableSize = 64;
-  std::vector<float> wallWeight_, wallGradient_;
-  float wallTableScale_ = 0;
+  VecD gravity_;
+  int substeps_;
+  Attractor<Dim> attractor_;
 
   // Particle channels (structure of arrays) and the neighbour grid.
   std::vector<VecD> x_, v_, p_;
@@ -96,6 +91,7 @@ class PbfSolver {
   std::vector<VecD> scratch_;  // reordering, position corrections and XSPH velocities, in turn
   std::vector<uint32_t> scratchIds_;
   NeighborGrid<Dim> grid_;
+  TankWalls<Dim> walls_;
   NeighborLists neighbors_;
   // Per neighbour pair, parallel to neighbors_: the spiky gradient factor g of Kernels::pair, computed by the
   // lambda pass and reused by the position-correction pass of the same iteration (same positions).
@@ -107,10 +103,5 @@ class PbfSolver {
 
 extern template class PbfSolver<2>;
 extern template class PbfSolver<3>;
-
-// Lattice sums at rest for an interior particle: sum_j W(r_ij) including j = i, and sum_j |grad W(r_ij)|^2.
-// Used to choose the particle mass so that the rest lattice has density rho_0, and to scale epsilon.
-template <int Dim>
-void restLatticeSums(const Kernels<Dim>& kernels, float spacing, double* weightSum, double* gradientSquaredSum);
 
 }  // namespace surge

@@ -1,12 +1,14 @@
 #include "sim/simulation.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include "core/errors.h"
 #include "sim/pbf_solver.h"
+#include "sim/wcsph_solver.h"
 
 namespace surge {
 namespace {
@@ -45,13 +47,20 @@ class StatsFile {
   std::vector<std::string> rows_;
 };
 
+// pressureMax is NaN for a solver without pressures (PBF) and written as an empty field.
 std::string statsRow(int frame, double time, size_t particles, int substeps, double iterations,
-                     const FluidMeasures& m, double wallSeconds, const PhaseTimes& t) {
+                     const FluidMeasures& m, double wallSeconds, const PhaseTimes& t, double timeStep,
+                     double pressureMax) {
   char row[512];
-  std::snprintf(row, sizeof row, "%d,%.6f,%zu,%d,%.2f,%.6g,%.6g,%.6g,%.4f,%.2f,%.2f,%.2f,%.2f", frame, time,
+  std::snprintf(row, sizeof row, "%d,%.6f,%zu,%d,%.2f,%.6g,%.6g,%.6g,%.4f,%.2f,%.2f,%.2f,%.2f,%.6g,", frame, time,
                 particles, substeps, iterations, m.densityErrorAvg, m.densityErrorMax, m.kineticEnergy,
-                wallSeconds, t.neighbors, t.constraint, t.vorticity, t.viscosity);
-  return row;
+                wallSeconds, t.neighbors, t.constraint, t.vorticity, t.viscosity, timeStep);
+  std::string text = row;
+  if (!std::isnan(pressureMax)) {
+    std::snprintf(row, sizeof row, "%.6g", pressureMax);
+    text += row;
+  }
+  return text;
 }
 
 void removeStaleFiles(const fs::path& folder, bool framesToo) {
@@ -64,14 +73,24 @@ void removeStaleFiles(const fs::path& folder, bool framesToo) {
   }
 }
 
-template <int Dim>
+[[noreturn]] void diverged(int frame, int substep, long particle, const ParticleFrame& state) {
+  throw RunError("simulation diverged at frame " + std::to_string(frame) + ", substep " + std::to_string(substep) +
+                 ": particle " + std::to_string(particle) + " (id " + std::to_string(state.id[particle]) + ") at " +
+                 formatVector(state.position[particle], state.dimensions) + " with velocity " +
+                 formatVector(state.velocity[particle], state.dimensions) + " (not finite or outside the domain)");
+}
+
+// The frame loop, for either solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
+// otherwise each step is the largest stable one (stableTimeStep) shortened so the steps left end exactly on the
+// frame: dt = remaining / ceil(remaining / stable).
+template <int Dim, typename Solver>
 SimulationSummary run(const Scene& scene, const fs::path& dir, bool resume, Progress& progress) {
   const auto runStart = std::chrono::steady_clock::now();
   const fs::path particleDir = dir / "particles";
   removeStaleFiles(particleDir, !resume);
   fs::create_directories(particleDir);
 
-  PbfSolver<Dim> solver(scene);
+  Solver solver(scene);
   SimulationSummary summary;
   const std::vector<int> existing = resume ? listFrames(dir, "particles", "ply") : std::vector<int>{};
   if (!existing.empty()) {
@@ -87,36 +106,52 @@ SimulationSummary run(const Scene& scene, const fs::path& dir, bool resume, Prog
   StatsFile stats(dir / "stats.csv", !fresh, summary.firstFrame);
   ParticleFrame frame;
   if (fresh) {
-    stats.add(statsRow(0, 0.0, solver.size(), 0, 0, solver.measure(), 0.0, PhaseTimes{}));
+    stats.add(statsRow(0, 0.0, solver.size(), 0, 0, solver.measure(), 0.0, PhaseTimes{}, 0.0, NAN));
     solver.getParticles(frame);
     writeParticlePly(framePath(dir, "particles", 0, "ply"), frame);
   }
 
-  const int substeps = scene.solver.substeps;
-  const float dt = static_cast<float>(1.0 / (scene.output.fps * substeps));
+  const double frameDuration = 1.0 / scene.output.fps;
+  constexpr int kMostSteps = 1000000;
   progress.start("simulate", static_cast<size_t>(scene.output.frames - summary.firstFrame));
   for (int f = summary.firstFrame + 1; f <= scene.output.frames; ++f) {
     Progress::checkInterrupt();
     const auto frameStart = std::chrono::steady_clock::now();
     solver.phaseTimes() = PhaseTimes{};
-    int iterations = 0;
-    for (int s = 0; s < substeps; ++s) {
-      const long bad = solver.step(dt);
+    double time = (f - 1) * frameDuration;
+    solver.beginFrame(time);
+    int iterations = 0, steps = 0;
+    float smallestStep = INFINITY;
+    double remaining = frameDuration;
+    while (remaining > 0) {
+      float dt;
+      if (solver.fixedSubsteps() > 0) {
+        dt = static_cast<float>(frameDuration / solver.fixedSubsteps());
+        remaining = steps + 1 == solver.fixedSubsteps() ? 0 : remaining - dt;
+      } else {
+        const double stable = solver.stableTimeStep();
+        const double count = std::max(1.0, std::ceil(remaining / stable - 1e-9));
+        dt = static_cast<float>(remaining / count);
+        remaining = count == 1 ? 0 : remaining - dt;
+      }
+      const long bad = solver.step(dt, time);
+      time += dt;
+      smallestStep = std::min(smallestStep, dt);
       iterations += solver.lastIterations();
       if (bad >= 0) {
         solver.getParticles(frame);
-        throw RunError("simulation diverged at frame " + std::to_string(f) + ", substep " + std::to_string(s) +
-                       ": particle " + std::to_string(bad) + " (id " + std::to_string(frame.id[bad]) +
-                       ") at " + formatVector(frame.position[bad], Dim) + " with velocity " +
-                       formatVector(frame.velocity[bad], Dim) + " (not finite or outside the domain)");
+        diverged(f, steps, bad, frame);
       }
+      if (++steps >= kMostSteps)
+        throw RunError("simulation stalled at frame " + std::to_string(f) + ": a million steps of " +
+                       std::to_string(dt) + " s did not finish the frame (the stable step collapsed)");
     }
     const FluidMeasures measures = solver.measure();
     solver.getParticles(frame);
     writeParticlePly(framePath(dir, "particles", f, "ply"), frame);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart).count();
-    stats.add(statsRow(f, f / scene.output.fps, solver.size(), substeps, double(iterations) / substeps, measures,
-                       seconds, solver.phaseTimes()));
+    stats.add(statsRow(f, f * frameDuration, solver.size(), steps, double(iterations) / steps, measures, seconds,
+                       solver.phaseTimes(), smallestStep, solver.maxPressure()));
     progress.advance();
   }
   progress.finish();
@@ -130,7 +165,7 @@ SimulationSummary run(const Scene& scene, const fs::path& dir, bool resume, Prog
 
 const char* statsCsvHeader() {
   return "frame,time,particles,substeps,iterations,density_error_avg,density_error_max,kinetic_energy,"
-         "wall_seconds,ms_neighbors,ms_constraint,ms_vorticity,ms_viscosity";
+         "wall_seconds,ms_neighbors,ms_constraint,ms_vorticity,ms_viscosity,time_step,pressure_max";
 }
 
 ParticleFrame initialParticles(const Scene& scene) {
@@ -157,8 +192,10 @@ ParticleFrame initialParticles(const Scene& scene) {
 }
 
 SimulationSummary simulate(const Scene& scene, const fs::path& dir, bool resume, Progress& progress) {
-  if (scene.solver.method != "pbf") throw InputError("solver.method", "'" + scene.solver.method + "' is not available");
-  return scene.dimensions == 2 ? run<2>(scene, dir, resume, progress) : run<3>(scene, dir, resume, progress);
+  const bool wcsph = scene.solver.method == "wcsph";
+  if (scene.dimensions == 2)
+    return wcsph ? run<2, WcsphSolver<2>>(scene, dir, resume, progress) : run<2, PbfSolver<2>>(scene, dir, resume, progress);
+  return wcsph ? run<3, WcsphSolver<3>>(scene, dir, resume, progress) : run<3, PbfSolver<3>>(scene, dir, resume, progress);
 }
 
 }  // namespace surge

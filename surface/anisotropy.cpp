@@ -1,14 +1,16 @@
 // Yu & Turk 2013 anisotropic kernels (YT13, ACM TOG 32(1)). Their section 3 in four steps, per particle i:
-//  1. Isotropic weights of the neighbours within r_i (YT13 eq. 11):  w_ij = 1 - (|x_i - x_j| / r_i)^3.
-//  2. Weighted mean and covariance (YT13 eq. 12-13):
+//  1. Isotropic weights of the neighbours within r_i:  w_ij = 1 - (|x_i - x_j| / r_i)^3.
+//  2. Weighted mean and covariance:
 //       x_i^w = sum_j w_ij x_j / sum_j w_ij,   C_i = sum_j w_ij (x_j - x_i^w)(x_j - x_i^w)^T / sum_j w_ij.
-//  3. Principal axes C_i = R diag(s1, s2, s3) R^T (s1 >= s2 >= s3, YT13 eq. 14), the small axes clamped to
-//     s1 / k_r and isolated particles (N_i < N_epsilon neighbours) made spheres (YT13 eq. 15):
+//  3. Principal axes C_i = R diag(s1, s2, s3) R^T (s1 >= s2 >= s3, an SVD in YT13, an eigen-decomposition
+//     of the symmetric C_i here), the small axes clamped to s1 / k_r and isolated particles (N_i < N_epsilon
+//     neighbours) made spheres:
 //       Sigma~ = k_s diag(s1, max(s2, s1/k_r), max(s3, s1/k_r))  if N_i >= N_epsilon, else k_n I,
-//     and G_i = (1/h) R Sigma~^-1 R^T (YT13 eq. 16), so that the kernel W(r, G) = sigma det(G) P(|G r|)
-//     (YT13 eq. 9) is thinner across the surface than along it.
-//  4. Laplacian smoothing of the centres (YT13 eq. 6):  x-bar_i = (1 - lambda) x_i + lambda x_i^w.
-// (Equation numbers as we read them in the TOG article; the formulas above are what the code does.)
+//     and G_i = (1/h) R Sigma~^-1 R^T, so that the kernel W(r, G) = sigma det(G) P(|G r|) is thinner across
+//     the surface than along it.
+//  4. Laplacian smoothing of the centres:  x-bar_i = (1 - lambda) x_i + lambda x_i^w.
+// (No equation numbers: the earlier ones were written from memory and we could not check them against the
+// article. The formulas above are what the code does, with YT13's symbols.)
 //
 // k_s: YT13 pick k_s = 1400 for their units; here it is 1 / s_iso, the variance that the same weights give on
 // the full rest lattice, so that an interior particle of a resting fluid gets G = I / h exactly and the
@@ -25,7 +27,7 @@
 namespace surge {
 namespace {
 
-double weight(double distance, double radius) {  // YT13 eq. 11
+double weight(double distance, double radius) {  // step 1
   if (distance >= radius) return 0;
   const double q = distance / radius;
   return 1 - q * q * q;
@@ -140,11 +142,11 @@ AnisotropicKernels anisotropicKernels(const std::vector<Eigen::Vector3f>& x, con
         neighbours += j != i;
       });
       mean /= sumW;  // sumW >= 1: the particle itself has weight 1
-      out.centre[i] = ((1 - p.lambda) * xi + p.lambda * mean).cast<float>();  // step 4, YT13 eq. 6
+      out.centre[i] = ((1 - p.lambda) * xi + p.lambda * mean).cast<float>();  // step 4
 
       Eigen::Matrix3d G;
       if (neighbours + 1 < p.neighbourThreshold) {
-        G = Eigen::Matrix3d::Identity() / (p.kn * h);  // isolated: a small sphere (YT13 eq. 15, k_n I)
+        G = Eigen::Matrix3d::Identity() / (p.kn * h);  // isolated: a small sphere (Sigma~ = k_n I)
       } else {
         Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
         grid.forNeighbours(x[i], [&](uint32_t j) {
@@ -162,7 +164,7 @@ AnisotropicKernels anisotropicKernels(const std::vector<Eigen::Vector3f>& x, con
         Eigen::Vector3d sigma(std::max(s[0], s1 / p.kr), std::max(s[1], s1 / p.kr), s1);
         sigma *= ks;
         const Eigen::Matrix3d& R = eigen.eigenvectors();
-        G = R * sigma.cwiseInverse().asDiagonal() * R.transpose() / h;  // YT13 eq. 16
+        G = R * sigma.cwiseInverse().asDiagonal() * R.transpose() / h;  // G_i of step 3
       }
       out.G[i] = G.cast<float>();
       // Half-extent of {r : |G r| <= 1} along each axis: the norm of the row of G^-1 (G is symmetric).

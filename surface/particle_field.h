@@ -8,10 +8,12 @@
 //      phi(x) = |x - x-bar| - r-bar,  x-bar = sum_i w_i x_i / sum_i w_i,  r-bar = r (one radius),
 //      w_i = k(|x - x_i| / R),  k(s) = max(0, 1 - s^2)^3;
 //    +band where no particle is within R.
-//  - Anisotropic: Yu & Turk 2013 eq. 1 with their anisotropic kernel (eq. 9, anisotropy.h):
+//  - Anisotropic: Yu & Turk 2013's density field with their anisotropic kernel (anisotropy.h):
 //      f(x) = sum_j V W(x - x-bar_j, G_j),  W(r, G) = sigma det(G) P(|G r|),  P(q) = max(0, 1 - q^2)^3,
-//    V = spacing^3 the rest volume of a particle and sigma = 315 / (64 pi) (the poly6 normalisation), so f is
-//    1 inside a fluid at rest; stored as the approximate distance (iso - f) * distanceScale.
+//    sigma = 315 / (64 pi) (the poly6 normalisation) and V = AnisotropicKernels::particleVolume, so f is 1
+//    inside a fluid at rest; stored as the first-order distance (iso - f) / |grad f| (the gradient summed
+//    analytically), which is right at the iso-surface whatever f's slope (a flat face's kernels are thin, and
+//    f falls from 2 to 0 within one spacing there), and +-band where f is flat.
 //  - Velocity: the Shepard average sum_i w_i v_i / sum_i w_i with the ZB05 weights (0 where no particle).
 #pragma once
 
@@ -44,7 +46,7 @@ struct FieldParameters {
   double support = 0;   // SmoothSpheres, Velocity: the weights' support R
   double band = 0;      // distances are clamped to +-band; blocks with no voxel inside (-band, band) are dropped
   double iso = 0.5;     // Anisotropic: the surface is f = iso
-  double volume = 0;    // Anisotropic: V
+  double volume = 0;    // Anisotropic: V, the volume of a particle
   // Distance fields: a block is taken as wholly inside, and skipped, when every cell of this size within
   // `support + band` of it holds a particle (0: never skip). Cells of 2 spacings hold 8 particles at rest.
   double occupancyCell = 0;

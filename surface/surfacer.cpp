@@ -3,7 +3,7 @@
 //
 // Method: a raw level set from particle_field.h (union of spheres, Zhu & Bridson blend or Yu & Turk
 // anisotropic kernels, by surface.method), re-distanced (LevelSetTracker), smoothed by mean-curvature flow and
-// eroded back to the fluid's volume (tools::LevelSetFilter, which renormalises the band with LevelSetTracker after every step),
+// eroded back to the fluid's volume (tools::LevelSetFilter; the erosion added to the distances in one pass),
 // meshed by tools::volumeToMesh at isovalue 0.
 #include "surface/surfacer.h"
 
@@ -19,7 +19,6 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <mutex>
@@ -48,9 +47,9 @@ constexpr int kSlabHalfLayers = 3;
 // a third of a voxel times its curvature in voxels), few enough to keep edges and small droplets.
 // How far below the sphere tops (in spacings) the smoothed union of spheres of radius = spacing lies on a flat
 // face of a square lattice, measured: with it, the faces of a 20x10x10 block's mesh land within 0.002
-// spacings of the fluid's faces (the mean bump height alone, computed, would give 0.089; the smoothing takes
-// the rest). For radii other than the spacing it is an approximation.
-constexpr double kDentFill = 0.15;
+// spacings of the fluid's faces (measured with the re-distancing below; it was 0.15 with three Eikonal
+// iterations after every smoothing step). For radii other than the spacing it is an approximation.
+constexpr double kDentFill = 0.17;
 // Eikonal iterations of the re-distancing: the band is 3 voxels each side and one iteration moves correct
 // distances about a voxel, so 3 reach across it (LevelSetTracker's default is 1, meant for a band already
 // nearly right after one step of motion).
@@ -68,8 +67,13 @@ constexpr double kZbSupport = 2.0;
 constexpr double kZbInset = 0.0;
 // Anisotropic (YT13): kernel support h = 2 spacings, PCA radius 3 spacings (YT13 take 2h; 3 spacings already
 // gives 60 neighbours to a particle of a flat face, above N_epsilon = 25, for a third of the cost), iso-value
-// half the rest field, and the flat face found kAnisoInset spacings under the fluid's face (measured on the
-// test block), eroded by that much (negative: dilated).
+// half the rest field (f = 1 inside a fluid at rest, exactly: AnisotropicKernels::particleVolume; 0.5 is where
+// an unsmoothed half-space of fluid ends), and kAnisoInset: where that surface lies under the fluid's face
+// on the test block (20x10x10, every face), measured. The smoothed centres of the outer layer sit 0.62
+// spacings inside it and their kernels are flattened to 0.8 spacings across, so f = 0.5 lies 0.72 spacings
+// under the fluid's face after the smoothing steps (0.74 before); 0.753 puts the faces within 0.001 spacings of
+// the fluid's (the rest of the 2.7% that the block loses is at its edges and corners, where the centres move
+// inward along two or three axes). The level set is dilated by that much after smoothing.
 constexpr double kAnisoSupport = 2.0;
 constexpr double kAnisoPca = 3.0;
 constexpr double kAnisoIso = 0.5;
@@ -180,7 +184,7 @@ double erosionOf(const Parameters& p) {
   // the centres of its outer layer, while the sphere union reaches `radius` beyond them at the centres and
   // h/sqrt(2) (for radius = h) between them. Eroding by radius - h/2 would put the sphere tops on the
   // fluid's face; the smoothed surface lies kDentFill * h under the tops, so that much less is eroded and the
-  // faces land on the fluid's (a 20x10x10 block then encloses N h^3 less 1.7%, lost at its rounded edges).
+  // faces land on the fluid's (a 20x10x10 block then encloses N h^3 less 0.6%, lost at its rounded edges).
   if (p.method == "spheres") return p.radius - 0.5 * p.spacing - kDentFill * p.spacing;
   if (p.method == "smooth_spheres") return p.radius - 0.5 * p.spacing - kZbInset * p.spacing;
   return -kAnisoInset * p.spacing;
@@ -208,13 +212,17 @@ FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
   // crossing outward, and trims it back to the narrow band. (tools::sdfToSdf, fast sweeping, did the same
   // here first and took 90% of the time: 85 s for a million particles, against 1.5 s for this.)
   openvdb::tools::LevelSetFilter<FloatGrid, FloatGrid, CtrlCInterrupter> filter(*grid, &interrupter);
-  const auto knob = [](const char* name, int fallback) { const char* v = std::getenv(name); return v ? std::atoi(v) : fallback; };
-  if (knob("SURGE_FIRST", 0)) filter.setSpatialScheme(openvdb::math::FIRST_BIAS);
-  filter.setNormCount(knob("SURGE_NORM0", kRenormalise));
+  filter.setNormCount(kRenormalise);
   filter.normalize();
   filter.prune();  // voxels now beyond the band become inactive background
   Progress::checkInterrupt();
-  filter.setNormCount(knob("SURGE_NORMK", kRenormalise));
+  // After each smoothing step one Eikonal iteration (LevelSetTracker's default): a step moves the surface by a
+  // fraction of a voxel, and a band that was a distance stays nearly one. 3 iterations a step (as before)
+  // cost 40% of a frame and changed the block's volume by 0.5% and the ball's radius by 0.03 voxels. The
+  // anisotropic field keeps 3: its dilation below moves the surface 1.5 voxels in CFL steps, and with one
+  // iteration a step the block lost 9% more.
+  const bool anisotropic = p.method == "anisotropic";
+  filter.setNormCount(anisotropic ? kRenormalise : 1);
 
   // Smooth first, erode second: mean-curvature flow fills the dents between the spheres and rounds the sphere
   // caps, the erosion then takes the surface back to the fluid. (Eroding first would leave a lone particle
@@ -222,15 +230,22 @@ FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
   for (int i = 0; i < scene.surface.smoothing_steps; ++i) filter.meanCurvature();
   // Positive offsets shrink the level set (phi + offset, phi < 0 inside).
   const double erosion = erosionOf(p);
-  if (erosion != 0 && knob("SURGE_EXACT", 0)) {
+  if (erosion > 0) {
+    // Eroding a signed distance is adding a constant to it, exactly: one pass over the band, then one track
+    // (dilate the band a voxel on the inside, re-distance, trim the outside) per voxel of erosion, rather
+    // than LevelSetFilter::offset's CFL steps of half a voxel, each followed by a track.
     openvdb::tree::LeafManager<FloatGrid::TreeType> leaves(grid->tree());
     const float c = float(erosion);
     leaves.foreach([c](FloatGrid::TreeType::LeafNodeType& leaf, size_t) {
       for (auto it = leaf.beginValueOn(); it; ++it) it.setValue(*it + c);
     });
-    const int tracks = int(std::ceil(std::abs(erosion) / p.voxel - 1e-9));
+    const int tracks = int(std::ceil(erosion / p.voxel - 1e-9));
+    filter.setNormCount(2 * kRenormalise);
     for (int i = 0; i < tracks; ++i) filter.track();
-  } else if (erosion != 0) filter.offset(float(erosion));
+  } else if (erosion < 0) {
+    // Dilation (anisotropic): the outer band must grow as the surface moves out, which the CFL steps do.
+    filter.offset(float(erosion));
+  }
   Progress::checkInterrupt();
   return grid;
 }

@@ -4,10 +4,11 @@
 //  1. A raw narrow-band level set of voxel size scene.surface.voxel_size and half-width 3 voxels, by
 //     scene.surface.method (particle_field.h, our own gather rasteriser, which never drops a particle):
 //     `spheres` (union of spheres of radius surface.particle_radius), `smooth_spheres` (Zhu & Bridson 2005),
-//     `anisotropic` (Yu & Turk 2013, anisotropy.h; iso-value not calibrated yet). Spheres under 1.5 voxels
+//     `anisotropic` (Yu & Turk 2013, anisotropy.h; iso-value half the rest field, dilated back to the fluid's
+//     faces by an inset measured on a block). Spheres under 1.5 voxels
 //     throw: the smoothing would erase them.
 //  2. Re-distance it (LevelSetTracker), smooth it by surface.smoothing_steps of mean-curvature flow and
-//     erode it back to the fluid's volume (tools::LevelSetFilter; spheres of radius ~ spacing make a block
+//     erode (or, for `anisotropic`, dilate) it back to the fluid's volume (tools::LevelSetFilter; spheres of radius ~ spacing make a block
 //     fatter than its N * spacing^3 of fluid).
 //  3. Mesh the zero crossing (tools::volumeToMesh), split quads into triangles, orient them outward and give
 //     each vertex the normalised level-set gradient as its normal.

@@ -84,3 +84,32 @@ TEST(Kernels, GradientPointsTowardsTheOtherParticle) {
 
 }  // namespace
 }  // namespace surge
+
+namespace surge {
+namespace {
+
+template <int Dim, typename Kernel>
+void expectKernelNormalisedWithMatchingGradient(float support) {
+  const Kernel kernel(support);
+  EXPECT_NEAR(radialIntegral<Dim>(support, [&](float r) { return kernel.value(r); }), 1.0, 1e-4);
+  // The gradient factor against central differences of W along r, at points on both pieces of the cubic.
+  for (float q : {0.1f, 0.3f, 0.45f, 0.55f, 0.8f, 0.95f}) {
+    const float r = q * support, step = 1e-3f * support;
+    const double numeric = (double(kernel.value(r + step)) - double(kernel.value(r - step))) / (2.0 * step);
+    // g r is the radial derivative; float rounding over the 2e-3 H step bounds the error as in the spiky test.
+    EXPECT_NEAR(kernel.gradientFactor(r) * r, numeric, 1e-3 * std::abs(numeric) + 1e-3 * kernel.value(0) / support)
+        << "q = " << q;
+  }
+  EXPECT_EQ(kernel.gradientFactor(0.0f), 0.0f);
+  EXPECT_EQ(kernel.value(support), 0.0f);
+}
+
+TEST(Kernels, CubicSplineAndWendlandAreNormalised) {
+  expectKernelNormalisedWithMatchingGradient<3, CubicSplineKernel<3>>(0.1f);
+  expectKernelNormalisedWithMatchingGradient<2, CubicSplineKernel<2>>(0.1f);
+  expectKernelNormalisedWithMatchingGradient<3, WendlandC2Kernel<3>>(0.1f);
+  expectKernelNormalisedWithMatchingGradient<2, WendlandC2Kernel<2>>(2.0f);
+}
+
+}  // namespace
+}  // namespace surge

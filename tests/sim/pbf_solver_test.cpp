@@ -108,7 +108,7 @@ namespace {
 
 const char* kColumn2d = R"({"name": "column", "dimensions": 2,
   "domain": {"min": [0, 0], "max": [0.4, 1.0]}, "particle_spacing": 0.02,
-  "fluids": [{"box": {"min": [0, 0], "max": [0.4, 0.4]}}], "output": {"fps": 30, "frames": 60}})";
+  "fluids": [{"box": {"min": [0, 0], "max": [0.4, 0.4]}}], "output": {"fps": 30, "frames": 90}})";
 
 // The mean height of the particles that started in the top layer (tracked by id, so a single droplet that
 // hops does not count as the surface moving).
@@ -125,8 +125,9 @@ float topLayerHeight(const PbfSolver<2>& solver, const std::vector<uint32_t>& to
 TEST(PbfSolver, ColumnAtRestStaysAtRest) {
   // A 2D column 20 particles deep on the floor, default solver settings (4 substeps, 4 iterations). In its
   // first frames it settles: the top layer, under-dense with nothing above it, sinks into the one below, and
-  // the Jacobi iterations leave the column a little compressed under its weight. Once settled (after 1 s) it
-  // must stay at rest: over the next second its top surface moves less than a tenth of the spacing.
+  // the Jacobi iterations leave the column a little compressed under its weight; the top layer sinks about a
+  // spacing over the first 2 s (measured: 0.39 -> 0.367 m, then within 0.0005 m). Once settled it must stay at
+  // rest: over the next second its top surface moves less than a tenth of the spacing.
   const Scene scene = parseScene(kColumn2d, "test");
   PbfSolver<2> solver(scene);
   const ParticleFrame initial = initialParticles(scene);
@@ -136,7 +137,7 @@ TEST(PbfSolver, ColumnAtRestStaysAtRest) {
   ASSERT_EQ(topIds.size(), 20u);
   solver.setParticles(initial);
   const float dt = 1.0f / (30 * 4);
-  for (int s = 0; s < 30 * 4; ++s) ASSERT_EQ(solver.step(dt), -1);
+  for (int s = 0; s < 2 * 30 * 4; ++s) ASSERT_EQ(solver.step(dt), -1);
   const float settled = topLayerHeight(solver, topIds);
   EXPECT_GT(settled, 0.39f - 0.02f * 2) << "the column collapsed by more than two spacings while settling";
   for (int s = 0; s < 30 * 4; ++s) ASSERT_EQ(solver.step(dt), -1);

@@ -1,0 +1,99 @@
+// What the frame loop reports of any solver: time per phase, the density error of DESIGN.md and the kinetic
+// energy, and the first particle that went bad. Shared by PBF and WCSPH.
+#pragma once
+
+#include <algorithm>
+#include <vector>
+
+#include "core/parallel.h"
+#include "sim/neighbor_grid.h"
+#include "sim/tank.h"
+
+namespace surge {
+
+// Milliseconds spent per phase, accumulated until reset. For WCSPH, "constraint" is density and pressure and
+// "viscosity" the force pass.
+struct PhaseTimes {
+  double neighbors = 0, constraint = 0, vorticity = 0, viscosity = 0;
+};
+
+// Density error as DESIGN.md defines it (compression only, max(rho_i / rho_0 - 1, 0)) averaged and maximised
+// over the particles, and the kinetic energy.
+struct FluidMeasures {
+  double densityErrorAvg = 0, densityErrorMax = 0, kineticEnergy = 0;
+};
+
+// The measures at positions x with neighbour lists of (nearly) those positions; weight(r2) is the density
+// kernel W as a function of the squared distance.
+template <int Dim, typename Weight>
+FluidMeasures measureDensityAndEnergy(const std::vector<Vec<Dim>>& x, const std::vector<Vec<Dim>>& v,
+                                      const NeighborLists& neighbors, const TankWalls<Dim>& walls, float mass,
+                                      float restDensity, Weight weight) {
+  struct Sums {
+    double errorSum = 0, errorMax = 0, energy = 0;
+    Sums& operator+=(const Sums& o) {
+      errorSum += o.errorSum;
+      errorMax = std::max(errorMax, o.errorMax);
+      energy += o.energy;
+      return *this;
+    }
+  };
+  const float selfWeight = weight(0.0f);
+  const Sums sums = parallelSum<Sums>(0, x.size(), [&](size_t b, size_t e) {
+    Sums s;
+    for (size_t i = b; i < e; ++i) {
+      float w = selfWeight;
+      for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) w += weight((x[i] - x[*j]).squaredNorm());
+      Vec<Dim> unusedGradient = Vec<Dim>::Zero();
+      walls.add(x[i], w, unusedGradient);
+      const double error = std::max(double(mass * w / restDensity) - 1.0, 0.0);
+      s.errorSum += error;
+      s.errorMax = std::max(s.errorMax, error);
+      s.energy += 0.5 * mass * v[i].squaredNorm();
+    }
+    return s;
+  });
+  FluidMeasures m;
+  m.densityErrorAvg = x.empty() ? 0 : sums.errorSum / double(x.size());
+  m.densityErrorMax = sums.errorMax;
+  m.kineticEnergy = sums.energy;
+  return m;
+}
+
+// The index of the first particle whose position or velocity is not finite or whose position left the tank,
+// or -1.
+template <int Dim>
+long firstParticleOutside(const std::vector<Vec<Dim>>& x, const std::vector<Vec<Dim>>& v,
+                          const TankWalls<Dim>& walls) {
+  struct First {
+    long index = -1;
+    First& operator+=(const First& o) {
+      if (index < 0 || (o.index >= 0 && o.index < index)) index = o.index;
+      return *this;
+    }
+  };
+  return parallelSum<First>(0, x.size(), [&](size_t b, size_t e) {
+           First first;
+           for (size_t i = b; i < e && first.index < 0; ++i)
+             if (!x[i].allFinite() || !v[i].allFinite() || !walls.contains(x[i])) first.index = static_cast<long>(i);
+           return first;
+         }).index;
+}
+
+// The largest value of `values`, in parallel.
+inline float parallelMax(const std::vector<float>& values) {
+  struct Max {
+    float value = 0;
+    Max& operator+=(const Max& o) {
+      value = std::max(value, o.value);
+      return *this;
+    }
+  };
+  return parallelSum<Max>(0, values.size(), [&](size_t b, size_t e) {
+           Max m;
+           for (size_t i = b; i < e; ++i) m.value = std::max(m.value, values[i]);
+           return m;
+         }).value;
+}
+
+}  // namespace surge

@@ -1,0 +1,169 @@
+// What both solvers share about the rest lattice and the tank:
+//  - latticeSums: sums of a kernel and of its squared gradient over the rest lattice around an interior
+//    particle, to choose the particle mass (the rest lattice has exactly rho_0) and scale PBF's epsilon;
+//  - TankWalls: the tank's walls as the rest lattice continued beyond them (after the boundary particles of
+//    Akinci et al. 2012, summed once, up front, into tables against the distance to the wall), so a particle of
+//    the rest lattice next to a wall has rho_0 as an interior one does and is pushed off the wall by the
+//    density it sees; and the collision response that keeps particle centres a particle radius inside.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "sim/kernels.h"
+
+namespace surge {
+
+// Over the lattice points r = spacing (i, j, k) with |r| < support, including r = 0: sum of weight(r) and of
+// |gradient(r)|^2, where weight and gradient are the kernel's W and grad W as functions of the offset vector.
+template <int Dim, typename Weight, typename Gradient>
+void latticeSums(float spacing, float support, Weight weight, Gradient gradient, double* weightSum,
+                 double* gradientSquaredSum) {
+  const int reach = static_cast<int>(std::ceil(support / spacing));
+  const int zReach = Dim == 3 ? reach : 0;
+  double w = 0, g = 0;
+  for (int i = -reach; i <= reach; ++i)
+    for (int j = -reach; j <= reach; ++j)
+      for (int k = -zReach; k <= zReach; ++k) {
+        Vec<Dim> r;
+        r[0] = i * spacing;
+        r[1] = j * spacing;
+        if constexpr (Dim == 3) r[2] = k * spacing;
+        w += weight(r);
+        g += gradient(r).squaredNorm();
+      }
+  *weightSum = w;
+  *gradientSquaredSum = g;
+}
+
+template <int Dim>
+class TankWalls {
+ public:
+  using VecD = Vec<Dim>;
+
+  // weight(r) and gradient(r): the kernel's W and grad_{p_i} W for the offset r = p_i - p_b.
+  template <typename Weight, typename Gradient>
+  TankWalls(const VecD& domainMin, const VecD& domainMax, float spacing, float support, Weight weight,
+            Gradient gradient)
+      : domainMin_(domainMin), domainMax_(domainMax) {
+    const float particleRadius = 0.5f * spacing;
+    clampMin_ = domainMin + VecD::Constant(particleRadius);
+    clampMax_ = domainMax - VecD::Constant(particleRadius);
+    // A particle at distance d from a wall sees lattice layers at d + spacing / 2 + k spacing beyond it,
+    // tangentially aligned with the particle. The wall normal is taken along axis 0 here.
+    const int reach = static_cast<int>(std::ceil(support / spacing)) + 1;
+    weight_.assign(kTableSize + 1, 0.0f);
+    gradient_.assign(kTableSize + 1, 0.0f);
+    tableScale_ = kTableSize / support;
+    for (int t = 0; t <= kTableSize; ++t) {
+      const float d = support * t / kTableSize;
+      double w = 0, g = 0;
+      for (int layer = 0; layer <= reach; ++layer)
+        for (int a = -reach; a <= reach; ++a)
+          for (int b = (Dim == 3 ? -reach : 0); b <= (Dim == 3 ? reach : 0); ++b) {
+            VecD r = VecD::Zero();
+            r[0] = d + particleRadius + layer * spacing;
+            r[1] = a * spacing;
+            if constexpr (Dim == 3) r[2] = b * spacing;
+            w += weight(r);
+            g += gradient(r)[0];  // <= 0: towards the wall
+          }
+      weight_[t] = static_cast<float>(w);
+      gradient_[t] = static_cast<float>(-g);
+    }
+    // Along an edge where two walls meet, both walls' lattices hold the quarter beyond both: tabulate that
+    // quarter (distances dA, dB to the two walls) so add() can count it once.
+    edgeScale_ = kEdgeTableSize / support;
+    edge_.assign((kEdgeTableSize + 1) * (kEdgeTableSize + 1), EdgeEntry{});
+    for (int ta = 0; ta <= kEdgeTableSize; ++ta)
+      for (int tb = 0; tb <= kEdgeTableSize; ++tb) {
+        double w = 0, ga = 0, gb = 0;
+        for (int i = 0; i <= reach; ++i)
+          for (int j = 0; j <= reach; ++j)
+            for (int c = (Dim == 3 ? -reach : 0); c <= (Dim == 3 ? reach : 0); ++c) {
+              VecD r = VecD::Zero();
+              r[0] = support * ta / kEdgeTableSize + particleRadius + i * spacing;
+              r[1] = support * tb / kEdgeTableSize + particleRadius + j * spacing;
+              if constexpr (Dim == 3) r[2] = c * spacing;
+              w += weight(r);
+              const VecD g = gradient(r);
+              ga += g[0];
+              gb += g[1];
+            }
+        edge_[ta * (kEdgeTableSize + 1) + tb] = {float(w), float(-ga), float(-gb)};
+      }
+  }
+
+  // Adds the walls' share of sum_b W(p - p_b) to `weight` and of sum_b grad W(p - p_b) to `gradient`.
+  void add(const VecD& p, float& weight, VecD& gradient) const {
+    for (int k = 0; k < Dim; ++k)
+      for (int side = 0; side < 2; ++side) {
+        const float d = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
+        const float u = std::max(d, 0.0f) * tableScale_;
+        if (!(u < kTableSize)) continue;  // also skips NaN
+        const int t = static_cast<int>(u);
+        const float f = u - t;
+        weight += (1 - f) * weight_[t] + f * weight_[t + 1];
+        const float g = (1 - f) * gradient_[t] + f * gradient_[t + 1];
+        gradient[k] += side == 0 ? -g : g;  // grad_{p_i} points towards the wall
+      }
+    // Edges: the quarter beyond two walls was added by each; take it away once. (Where three walls meet, the
+    // eighth beyond all three is then missing, at the tank's eight corners only.)
+    for (int k = 0; k < Dim; ++k)
+      for (int k2 = k + 1; k2 < Dim; ++k2)
+        for (int sides = 0; sides < 4; ++sides) {
+          const int side = sides & 1, side2 = sides >> 1;
+          const float d = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
+          const float d2 = side2 == 0 ? p[k2] - domainMin_[k2] : domainMax_[k2] - p[k2];
+          const float u = std::max(d, 0.0f) * edgeScale_, u2 = std::max(d2, 0.0f) * edgeScale_;
+          if (!(u < kEdgeTableSize) || !(u2 < kEdgeTableSize)) continue;
+          const int t = static_cast<int>(u), t2 = static_cast<int>(u2);
+          const float f = u - t, f2 = u2 - t2;
+          auto at = [&](int a, int b) { return edge_[a * (kEdgeTableSize + 1) + b]; };
+          const EdgeEntry e00 = at(t, t2), e01 = at(t, t2 + 1), e10 = at(t + 1, t2), e11 = at(t + 1, t2 + 1);
+          auto blend = [&](float EdgeEntry::*field) {
+            return (1 - f) * ((1 - f2) * e00.*field + f2 * e01.*field) + f * ((1 - f2) * e10.*field + f2 * e11.*field);
+          };
+          weight -= blend(&EdgeEntry::weight);
+          const float ga = blend(&EdgeEntry::gradientA), gb = blend(&EdgeEntry::gradientB);
+          gradient[k] -= side == 0 ? -ga : ga;
+          gradient[k2] -= side2 == 0 ? -gb : gb;
+        }
+  }
+
+  // Collision response: projects p back to a particle radius inside the tank. NaN stays NaN (comparisons with
+  // NaN are false), so a diverged particle is reported rather than hidden at a wall. Returns the axes moved
+  // as bits, so that a solver can stop the velocity into the wall.
+  int clamp(VecD& p) const {
+    int moved = 0;
+    for (int k = 0; k < Dim; ++k) {
+      if (p[k] < clampMin_[k]) {
+        p[k] = clampMin_[k];
+        moved |= 1 << k;
+      } else if (p[k] > clampMax_[k]) {
+        p[k] = clampMax_[k];
+        moved |= 1 << k;
+      }
+    }
+    return moved;
+  }
+
+  bool contains(const VecD& p) const {
+    return (p.array() >= domainMin_.array()).all() && (p.array() <= domainMax_.array()).all();
+  }
+
+ private:
+  static constexpr int kTableSize = 64;
+  static constexpr int kEdgeTableSize = 32;
+  struct EdgeEntry {
+    float weight = 0, gradientA = 0, gradientB = 0;  // gradients: magnitudes towards each wall
+  };
+  VecD domainMin_, domainMax_, clampMin_, clampMax_;
+  std::vector<float> weight_, gradient_;
+  float tableScale_ = 0;
+  std::vector<EdgeEntry> edge_;
+  float edgeScale_ = 0;
+};
+
+}  // namespace surge

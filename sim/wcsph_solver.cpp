@@ -1,0 +1,280 @@
+#include "sim/wcsph_solver.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "core/parallel.h"
+
+namespace surge {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double millisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+template <int Dim>
+Vec<Dim> toVec(const Eigen::Vector3d& v) {
+  return v.head<Dim>().template cast<float>();
+}
+
+// The tank's walls seen through the scene's kernel.
+template <int Dim>
+TankWalls<Dim> makeWalls(const Scene& scene) {
+  const float support = static_cast<float>(scene.solver.kernel_radius);
+  const float spacing = static_cast<float>(scene.particle_spacing);
+  const Vec<Dim> lo = toVec<Dim>(scene.domain.min), hi = toVec<Dim>(scene.domain.max);
+  auto build = [&](const auto& kernel) {
+    return TankWalls<Dim>(
+        lo, hi, spacing, support, [&](const Vec<Dim>& r) { return kernel.value(r.norm()); },
+        [&](const Vec<Dim>& r) -> Vec<Dim> { return kernel.gradientFactor(r.norm()) * r; });
+  };
+  if (scene.solver.kernel == "wendland_c2") return build(WendlandC2Kernel<Dim>(support));
+  return build(CubicSplineKernel<Dim>(support));
+}
+
+}  // namespace
+
+template <int Dim>
+WcsphSolver<Dim>::WcsphSolver(const Scene& scene)
+    : wendland_(scene.solver.kernel == "wendland_c2"),
+      verlet_(scene.solver.integrator == "velocity_verlet"),
+      tait_(scene.solver.equation_of_state == "tait"),
+      cubic_(static_cast<float>(scene.solver.kernel_radius)),
+      wendland_kernel_(static_cast<float>(scene.solver.kernel_radius)),
+      attractor_(scene.attractor),
+      grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
+            static_cast<float>(0.5 * scene.solver.kernel_radius)),
+      walls_(makeWalls<Dim>(scene)) {
+  const SolverSettings& s = scene.solver;
+  support_ = static_cast<float>(s.kernel_radius);
+  smoothingLength_ = 0.5f * support_;
+  restDensity_ = static_cast<float>(s.rest_density);
+  // The mass gives the rest lattice exactly rho_0 (the same choice as PBF's, with this kernel).
+  double weightSum = 0, unused = 0;
+  const float spacing = static_cast<float>(scene.particle_spacing);
+  auto sums = [&](const auto& kernel) {
+    latticeSums<Dim>(spacing, support_, [&](const VecD& r) { return kernel.value(r.norm()); },
+                     [&](const VecD& r) -> VecD { return kernel.gradientFactor(r.norm()) * r; }, &weightSum, &unused);
+  };
+  if (wendland_) sums(wendland_kernel_);
+  else sums(cubic_);
+  mass_ = static_cast<float>(s.rest_density / weightSum);
+  speedOfSound_ = static_cast<float>(s.speed_of_sound);
+  gasConstant_ = static_cast<float>(s.gas_constant);
+  taitB_ = restDensity_ * speedOfSound_ * speedOfSound_ / 7.0f;
+  alpha_ = static_cast<float>(s.artificial_viscosity);
+  nu_ = static_cast<float>(s.kinematic_viscosity);
+  nearStiffness_ = static_cast<float>(s.near_pressure);
+  cfl_ = static_cast<float>(s.cfl);
+  fixedStep_ = static_cast<float>(s.time_step);
+  gravity_ = toVec<Dim>(scene.gravity);
+}
+
+template <int Dim>
+void WcsphSolver<Dim>::setParticles(const ParticleFrame& frame) {
+  const size_t n = frame.size();
+  x_.resize(n);
+  v_.resize(n);
+  a_.assign(n, VecD::Zero());
+  id_ = frame.id;
+  density_.assign(n, restDensity_);
+  pressure_.assign(n, 0.0f);
+  if (nearStiffness_ > 0) nearPressure_.assign(n, 0.0f);
+  for (size_t i = 0; i < n; ++i) {
+    x_[i] = frame.position[i].head<Dim>();
+    v_[i] = frame.velocity[i].head<Dim>();
+  }
+  accelerationsValid_ = false;
+}
+
+template <int Dim>
+void WcsphSolver<Dim>::getParticles(ParticleFrame& frame) const {
+  const size_t n = x_.size();
+  frame.dimensions = Dim;
+  frame.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    frame.position[i].setZero();
+    frame.velocity[i].setZero();
+    frame.position[i].head<Dim>() = x_[i];
+    frame.velocity[i].head<Dim>() = v_[i];
+  }
+  frame.id = id_;
+}
+
+template <int Dim>
+void WcsphSolver<Dim>::beginFrame(double) {
+  accelerationsValid_ = false;
+  framePressureMax_ = 0;
+}
+
+// dt = min(cfl h / (c + |v|max), 0.125 h^2 / nu, 0.25 sqrt(h / |a|max)), h the smoothing length (half the
+// support): the CFL condition on the speed of sound and the fastest particle, and the viscous and force limits
+// of Monaghan 1992 / Morris et al. 1997.
+template <int Dim>
+float WcsphSolver<Dim>::stableTimeStep() {
+  if (fixedStep_ > 0) return fixedStep_;
+  if (!accelerationsValid_) {
+    computeAccelerations(0.0);  // at the frame's start; the time only moves the attractor, see step()
+  }
+  struct Maxima {
+    float speed = 0, acceleration = 0;
+    Maxima& operator+=(const Maxima& o) {
+      speed = std::max(speed, o.speed);
+      acceleration = std::max(acceleration, o.acceleration);
+      return *this;
+    }
+  };
+  const Maxima m = parallelSum<Maxima>(0, size(), [&](size_t b, size_t e) {
+    Maxima local;
+    for (size_t i = b; i < e; ++i) {
+      local.speed = std::max(local.speed, v_[i].norm());
+      local.acceleration = std::max(local.acceleration, a_[i].norm());
+    }
+    return local;
+  });
+  const float h = smoothingLength_;
+  float dt = cfl_ * h / (speedOfSound_ + m.speed);
+  if (nu_ > 0) dt = std::min(dt, 0.125f * h * h / nu_);
+  if (m.acceleration > 0) dt = std::min(dt, 0.25f * std::sqrt(h / m.acceleration));
+  return dt;
+}
+
+template <int Dim>
+void WcsphSolver<Dim>::drift(float dt) {
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      x_[i] += dt * v_[i];
+      const int moved = walls_.clamp(x_[i]);
+      for (int k = 0; k < Dim; ++k)
+        if (moved & (1 << k)) v_[i][k] = 0;  // no velocity into a wall the particle was stopped at
+    }
+  });
+}
+
+template <int Dim>
+long WcsphSolver<Dim>::step(float dt, double time) {
+  if (!accelerationsValid_) computeAccelerations(time);
+  if (verlet_) {
+    // Kick-drift-kick: v += dt/2 a(x_n); x += dt v; v += dt/2 a(x_n+1).
+    parallelFor(0, size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) v_[i] += (0.5f * dt) * a_[i];
+    });
+    drift(dt);
+    computeAccelerations(time + dt);
+    parallelFor(0, size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) v_[i] += (0.5f * dt) * a_[i];
+    });
+    accelerationsValid_ = true;  // a(x_n+1), with the half-step velocity in its viscous terms
+  } else {
+    // Semi-implicit Euler: v += dt a(x_n, v_n); x += dt v.
+    parallelFor(0, size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) v_[i] += dt * a_[i];
+    });
+    drift(dt);
+    accelerationsValid_ = false;
+  }
+  return firstParticleOutside(x_, v_, walls_);
+}
+
+template <int Dim>
+void WcsphSolver<Dim>::computeAccelerations(double time) {
+  // Neighbours of the current positions; every channel is reordered by cell first.
+  const auto start = Clock::now();
+  grid_.sort(x_);
+  const std::vector<uint32_t>& order = grid_.sortedOrder();
+  gatherByOrder(order, x_, scratch_);
+  gatherByOrder(order, v_, scratch_);
+  gatherByOrder(order, id_, scratchIds_);
+  grid_.findNeighbors(x_, support_, neighbors_);
+  times_.neighbors += millisecondsSince(start);
+  if (wendland_) computeAccelerationsWith(wendland_kernel_, time);
+  else computeAccelerationsWith(cubic_, time);
+  accelerationsValid_ = true;
+}
+
+template <int Dim>
+template <typename Kernel>
+void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double time) {
+  auto start = Clock::now();
+  const float selfWeight = kernel.value(0.0f);
+  const bool near = nearStiffness_ > 0;
+  const float inverseSupport = 1.0f / support_;
+  // Density by summation and the equation of state.
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      float weight = selfWeight, nearDensity = 0;
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
+        const float r = (x_[i] - x_[*j]).norm();
+        weight += kernel.value(r);
+        if (near) {
+          const float d = std::max(1.0f - r * inverseSupport, 0.0f);
+          nearDensity += d * d * d;
+        }
+      }
+      VecD unusedGradient = VecD::Zero();
+      walls_.add(x_[i], weight, unusedGradient);
+      density_[i] = mass_ * weight;
+      const float ratio = density_[i] / restDensity_;
+      const float p = tait_ ? taitB_ * (std::pow(ratio, 7.0f) - 1.0f) : gasConstant_ * (density_[i] - restDensity_);
+      pressure_[i] = std::max(p, 0.0f);
+      if (near) nearPressure_[i] = nearStiffness_ * nearDensity;
+    }
+  });
+  framePressureMax_ = std::max(framePressureMax_, parallelMax(pressure_));
+  times_.constraint += millisecondsSince(start);
+
+  // Forces, gathered per particle.
+  start = Clock::now();
+  const VecD attractorAt = attractor_.active() ? attractor_.position(time) : VecD::Zero();
+  const float h = smoothingLength_;
+  const float eta2 = 0.01f * h * h;
+  const float laminar = 2.0f * (Dim + 2) * nu_;
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const float pressureTermI = pressure_[i] / (density_[i] * density_[i]);
+      VecD pressureForce = VecD::Zero(), viscousForce = VecD::Zero(), nearForce = VecD::Zero();
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
+        const VecD r = x_[i] - x_[*j];
+        const float length = r.norm();
+        const VecD gradient = kernel.gradientFactor(length) * r;
+        pressureForce -= (pressureTermI + pressure_[*j] / (density_[*j] * density_[*j])) * gradient;
+        const VecD vij = v_[i] - v_[*j];
+        const float mu = vij.dot(r) / (length * length + eta2);
+        if (alpha_ > 0 && mu < 0) {
+          const float meanDensity = 0.5f * (density_[i] + density_[*j]);
+          viscousForce += (alpha_ * speedOfSound_ * h * mu / meanDensity) * gradient;
+        }
+        if (nu_ > 0) viscousForce += (laminar * mu / density_[*j]) * gradient;
+        if (near && length > 1e-12f) {
+          const float d = std::max(1.0f - length * inverseSupport, 0.0f);
+          nearForce += ((nearPressure_[i] + nearPressure_[*j]) * d * d * inverseSupport / length) * r;
+        }
+      }
+      // The walls as mirrored particles with this particle's pressure.
+      float unusedWeight = 0;
+      VecD wallGradient = VecD::Zero();
+      walls_.add(x_[i], unusedWeight, wallGradient);
+      pressureForce -= 2.0f * pressureTermI * wallGradient;
+      VecD acceleration = gravity_ + mass_ * (pressureForce + viscousForce) + nearForce;
+      if (attractor_.active()) acceleration += attractor_.acceleration(x_[i], attractorAt);
+      a_[i] = acceleration;
+    }
+  });
+  times_.viscosity += millisecondsSince(start);
+}
+
+template <int Dim>
+FluidMeasures WcsphSolver<Dim>::measure() {
+  if (neighbors_.size() != size()) computeAccelerations(0.0);
+  auto sums = [&](const auto& kernel) {
+    return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, walls_, mass_, restDensity_,
+                                        [&](float r2) { return kernel.value(std::sqrt(r2)); });
+  };
+  return wendland_ ? sums(wendland_kernel_) : sums(cubic_);
+}
+
+template class WcsphSolver<2>;
+template class WcsphSolver<3>;
+
+}  // namespace surge

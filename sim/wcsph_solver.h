@@ -1,0 +1,94 @@
+// Weakly compressible SPH (Monaghan 1994, "Simulating free surface flows with SPH"; Becker & Teschner 2007,
+// "Weakly compressible SPH for free surface flows"), in 2D and 3D, sharing the neighbour grid, the tank walls
+// and the frame loop with PBF. Per evaluation:
+//   density by summation     rho_i = sum_j m W_ij (+ the walls, sim/tank.h)
+//   equation of state        Tait p = rho_0 c^2 / 7 ((rho / rho_0)^7 - 1), or the gas law p = k (rho - rho_0);
+//                            negative pressures are clamped to 0 so the free surface does not pull together
+//   symmetric pressure force a_i = -sum_j m (p_i / rho_i^2 + p_j / rho_j^2) grad W_ij
+//   viscosity                artificial (Monaghan 1992): Pi_ij = -alpha c h mu_ij / rho_ij for approaching pairs,
+//                            mu_ij = v_ij . x_ij / (|x_ij|^2 + 0.01 h^2); laminar (Morris et al. 1997):
+//                            a_i += 2 (d + 2) nu sum_j (m / rho_j) mu_ij grad W_ij
+//   near pressure (opt-in)   Clavet et al. 2005's near density sum_j (1 - q)^3 and near pressure k_near times it,
+//                            as a force pushing close pairs apart
+//   gravity and the attractor (sim/attractor.h)
+// Time integration: velocity Verlet (kick-drift-kick), or semi-implicit Euler; the step from the CFL condition
+// on c + |v|max, the viscous limit and the force limit (or fixed). The integrator restarts at every output frame
+// from (x, v), so a run resumed from a frame file continues exactly as an uninterrupted one.
+#pragma once
+
+#include <vector>
+
+#include "core/ply.h"
+#include "core/scene.h"
+#include "sim/attractor.h"
+#include "sim/kernels.h"
+#include "sim/neighbor_grid.h"
+#include "sim/measures.h"
+#include "sim/tank.h"
+
+namespace surge {
+
+template <int Dim>
+class WcsphSolver {
+ public:
+  using VecD = Vec<Dim>;
+
+  explicit WcsphSolver(const Scene& scene);
+
+  void setParticles(const ParticleFrame& frame);
+  void getParticles(ParticleFrame& frame) const;
+  size_t size() const { return x_.size(); }
+
+  // Steps are chosen by the solver (stableTimeStep), not a fixed count per frame.
+  int fixedSubsteps() const { return 0; }
+  // Start of an output frame at `time`: forget the stored accelerations (see the header comment).
+  void beginFrame(double time);
+  // The largest stable step for the current state (or the scene's fixed time_step).
+  float stableTimeStep();
+  // One step of dt from `time`. Returns the index of the first particle that is not finite or left the tank, or -1.
+  long step(float dt, double time);
+
+  FluidMeasures measure();
+  float maxPressure() const { return framePressureMax_; }
+  int lastIterations() const { return 0; }
+  PhaseTimes& phaseTimes() { return times_; }
+  float particleMass() const { return mass_; }
+  float speedOfSound() const { return speedOfSound_; }
+  const std::vector<VecD>& positions() const { return x_; }
+  const std::vector<VecD>& velocities() const { return v_; }
+  // Pressures of the last evaluation, in the particles' current order (for tests).
+  const std::vector<float>& pressures() const { return pressure_; }
+
+ private:
+  void computeAccelerations(double time);
+  template <typename Kernel>
+  void computeAccelerationsWith(const Kernel& kernel, double time);
+  void drift(float dt);
+
+  // Parameters.
+  bool wendland_, verlet_, tait_;
+  CubicSplineKernel<Dim> cubic_;
+  WendlandC2Kernel<Dim> wendland_kernel_;
+  float support_, smoothingLength_, restDensity_, mass_, speedOfSound_, gasConstant_, taitB_;
+  float alpha_, nu_, nearStiffness_, cfl_, fixedStep_;
+  VecD gravity_;
+  Attractor<Dim> attractor_;
+
+  // Particle channels.
+  std::vector<VecD> x_, v_, a_, scratch_;
+  std::vector<uint32_t> id_, scratchIds_;
+  std::vector<float> density_, pressure_;
+  std::vector<float> nearPressure_;  // only with near_pressure > 0
+  NeighborGrid<Dim> grid_;
+  TankWalls<Dim> walls_;
+  NeighborLists neighbors_;
+
+  bool accelerationsValid_ = false;
+  float framePressureMax_ = 0;
+  PhaseTimes times_;
+};
+
+extern template class WcsphSolver<2>;
+extern template class WcsphSolver<3>;
+
+}  // namespace surge
