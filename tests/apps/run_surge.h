@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <fstream>
@@ -18,8 +19,9 @@ struct SurgeResult {
 };
 
 // Runs surge with `arguments` (a shell-quoted string), capturing stdout and stderr.
+// The captured output goes to files of this process's own (ctest runs test programs in parallel).
 inline SurgeResult runSurge(const std::string& arguments) {
-  const fs::path dir = fs::path(testing::TempDir()) / "surge_e2e_io";
+  const fs::path dir = fs::path(testing::TempDir()) / ("surge_e2e_io_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string command = std::string(SURGE_BINARY) + " " + arguments + " >" + (dir / "out").string() +
                               " 2>" + (dir / "err").string();
@@ -33,7 +35,7 @@ inline SurgeResult runSurge(const std::string& arguments) {
 
 // Writes a scene file into the test's temporary folder.
 inline fs::path writeTestScene(const std::string& name, const std::string& text) {
-  const fs::path path = fs::path(testing::TempDir()) / name;
+  const fs::path path = fs::path(testing::TempDir()) / (std::to_string(::getpid()) + "_" + name);
   std::ofstream(path) << text;
   return path;
 }
