@@ -36,6 +36,7 @@ void addSurfaceCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addVideoCommand(CLI::App& app);
 void addKeysCommand(CLI::App& app);
+void addStudyCommand(CLI::App& app);
 
 // The stages, shared by their own subcommands and by `surge run`.
 void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const CommonOptions& options);

@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   addRenderCommand(app);
   addVideoCommand(app);
   addKeysCommand(app);
+  addStudyCommand(app);
   installInterruptHandler();
   try {
     app.parse(argc, argv);

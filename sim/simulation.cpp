@@ -1,5 +1,6 @@
 #include "sim/simulation.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -50,7 +51,7 @@ class StatsFile {
 // pressureMax is NaN for a solver without pressures (PBF) and written as an empty field.
 std::string statsRow(int frame, double time, size_t particles, int substeps, double iterations,
                      const FluidMeasures& m, double wallSeconds, const PhaseTimes& t, double timeStep,
-                     double pressureMax) {
+                     double pressureMax, const DamBreakMeasures& dam) {
   char row[512];
   std::snprintf(row, sizeof row, "%d,%.6f,%zu,%d,%.2f,%.6g,%.6g,%.6g,%.4f,%.2f,%.2f,%.2f,%.2f,%.6g,", frame, time,
                 particles, substeps, iterations, m.densityErrorAvg, m.densityErrorMax, m.kineticEnergy,
@@ -60,7 +61,8 @@ std::string statsRow(int frame, double time, size_t particles, int substeps, dou
     std::snprintf(row, sizeof row, "%.6g", pressureMax);
     text += row;
   }
-  return text;
+  std::snprintf(row, sizeof row, ",%.6g,%.6g", dam.frontX, dam.backHeight);
+  return text + row;
 }
 
 void removeStaleFiles(const fs::path& folder, bool framesToo) {
@@ -71,6 +73,23 @@ void removeStaleFiles(const fs::path& folder, bool framesToo) {
     const bool temporary = name.find(".tmp") != std::string::npos;
     if (temporary || (framesToo && name.rfind("frame_", 0) == 0)) fs::remove(entry.path(), error);
   }
+}
+
+// The x wall the fluid started against: +1 for domain.min.x, -1 for domain.max.x.
+int startWallSide(const Scene& scene) {
+  if (scene.fluids.empty()) return 1;
+  const Box& box = scene.fluids.front().box;
+  const double tolerance = 0.5 * scene.particle_spacing;
+  if (box.min.x() <= scene.domain.min.x() + tolerance) return 1;
+  if (box.max.x() >= scene.domain.max.x() - tolerance) return -1;
+  return box.min.x() - scene.domain.min.x() <= scene.domain.max.x() - box.max.x() ? 1 : -1;
+}
+
+// From the sorted values, starting at index `start`, the last value reached by steps shorter than `gap`.
+float walkWhileContiguous(const std::vector<float>& sorted, size_t start, float gap) {
+  size_t i = start;
+  while (i + 1 < sorted.size() && sorted[i + 1] - sorted[i] < gap) ++i;
+  return sorted[i];
 }
 
 [[noreturn]] void diverged(int frame, int substep, long particle, const ParticleFrame& state) {
@@ -106,8 +125,9 @@ SimulationSummary run(const Scene& scene, const fs::path& dir, bool resume, Prog
   StatsFile stats(dir / "stats.csv", !fresh, summary.firstFrame);
   ParticleFrame frame;
   if (fresh) {
-    stats.add(statsRow(0, 0.0, solver.size(), 0, 0, solver.measure(), 0.0, PhaseTimes{}, 0.0, NAN));
     solver.getParticles(frame);
+    stats.add(statsRow(0, 0.0, solver.size(), 0, 0, solver.measure(), 0.0, PhaseTimes{}, 0.0, NAN,
+                       measureDamBreak(scene, frame)));
     writeParticlePly(framePath(dir, "particles", 0, "ply"), frame);
   }
 
@@ -151,7 +171,7 @@ SimulationSummary run(const Scene& scene, const fs::path& dir, bool resume, Prog
     writeParticlePly(framePath(dir, "particles", f, "ply"), frame);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart).count();
     stats.add(statsRow(f, f * frameDuration, solver.size(), steps, double(iterations) / steps, measures, seconds,
-                       solver.phaseTimes(), smallestStep, solver.maxPressure()));
+                       solver.phaseTimes(), smallestStep, solver.maxPressure(), measureDamBreak(scene, frame)));
     progress.advance();
   }
   progress.finish();
@@ -165,7 +185,38 @@ SimulationSummary run(const Scene& scene, const fs::path& dir, bool resume, Prog
 
 const char* statsCsvHeader() {
   return "frame,time,particles,substeps,iterations,density_error_avg,density_error_max,kinetic_energy,"
-         "wall_seconds,ms_neighbors,ms_constraint,ms_vorticity,ms_viscosity,time_step,pressure_max";
+         "wall_seconds,ms_neighbors,ms_constraint,ms_vorticity,ms_viscosity,time_step,pressure_max,front_x,back_height";
+}
+
+DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame) {
+  DamBreakMeasures m;
+  if (frame.size() == 0) return m;
+  const int side = startWallSide(scene);
+  const double wall = side > 0 ? scene.domain.min.x() : scene.domain.max.x();
+  const float gap = static_cast<float>(scene.solver.kernel_radius > 0 ? scene.solver.kernel_radius
+                                                                        : 2 * scene.particle_spacing);
+  const double radius = 0.5 * scene.particle_spacing;
+  std::vector<float> distance(frame.size()), height;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const float d = static_cast<float>(side * (frame.position[i].x() - wall));
+    distance[i] = d;
+    if (d < gap) height.push_back(static_cast<float>(frame.position[i].y() - scene.domain.min.y()));
+  }
+  std::sort(distance.begin(), distance.end());
+  m.frontX = walkWhileContiguous(distance, distance.size() / 2, gap) + radius;
+  std::sort(height.begin(), height.end());
+  if (!height.empty() && height.front() < gap) m.backHeight = walkWhileContiguous(height, 0, gap) + radius;
+  return m;
+}
+
+bool isDamBreak(const Scene& scene) {
+  if (scene.fluids.size() != 1) return false;
+  const Box& box = scene.fluids.front().box;
+  const double tolerance = 0.5 * scene.particle_spacing;
+  const bool onFloor = box.min.y() <= scene.domain.min.y() + tolerance;
+  const bool atMin = box.min.x() <= scene.domain.min.x() + tolerance;
+  const bool atMax = box.max.x() >= scene.domain.max.x() - tolerance;
+  return onFloor && atMin != atMax;
 }
 
 ParticleFrame initialParticles(const Scene& scene) {

@@ -24,6 +24,26 @@ struct SimulationSummary {
 // simulation diverges (earlier frames stay intact), Interrupted on Ctrl-C.
 SimulationSummary simulate(const Scene& scene, const fs::path& dir, bool resume, Progress& progress);
 
+// The dam-break measures of stats.csv, in metres, from one frame (deterministic: a sort of a copy).
+// The start wall is the x wall the first fluid box touches (the nearer one if it touches neither, domain.min.x if
+// both); distances are measured from it, so a dam break against either wall reads the same.
+//   frontX      the leading edge of the water, as a distance from the start wall: sort the particles' distances,
+//               start at the median (inside the body) and walk forwards while consecutive distances are less
+//               than one kernel radius apart; a particle further than that ahead of all behind it has no
+//               neighbour in the body, so it is a detached droplet and the walk stops before it. Plus half a
+//               spacing (the particle radius), so a block at rest reads its box's width exactly.
+//   backHeight  the height of the water column at the start wall: the particles within one kernel radius of
+//               it, walked up from the floor the same way (0 if none touches the floor there), plus half a
+//               spacing, measured from domain.min.y.
+struct DamBreakMeasures {
+  double frontX = 0, backHeight = 0;
+};
+DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame);
+
+// True for a scene whose fluid is one box on the floor against one x wall (and not the other): a dam break,
+// whose front_x and back_height can be compared with experiments (Martin & Moyce 1952) and across runs.
+bool isDamBreak(const Scene& scene);
+
 // The columns of stats.csv, in order.
 const char* statsCsvHeader();
 

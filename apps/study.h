@@ -1,0 +1,66 @@
+// `surge study`: a sweep of scene settings, each combination simulated by its own `surge sim` child process,
+// compared with the most expensive run. study_command.cpp runs the sweep; study_report.cpp reads the runs'
+// stats.csv and frames, computes the accuracy figures, and writes study.csv and the gnuplot plots.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/files.h"
+#include "core/scene.h"
+
+namespace surge {
+
+// One --sweep key=v1,v2,...
+struct Sweep {
+  std::string key;
+  std::vector<std::string> values;
+};
+
+// Parses "key=v1,v2,...", splitting at commas outside brackets and quotes (so `fluids[0].velocity=[1,0],[2,0]`
+// gives two values). Throws InputError naming --sweep.
+Sweep parseSweep(const std::string& text);
+
+// What one run left behind, and what the study measured of it.
+struct StudyRun {
+  int index = 0;
+  std::vector<std::string> values;  // one per sweep, in sweep order
+  fs::path folder;
+  std::string status = "ok";  // ok, diverged, failed
+  std::string message;        // the child's last stderr line when not ok
+  double cpuSeconds = 0, wallSeconds = 0, peakMegabytes = 0;
+
+  // From stats.csv.
+  size_t particles = 0;
+  int framesDone = 0;
+  long steps = 0;
+  double work = 0;  // sum over frames of particles x substeps x (1 + iterations): the cost the reference maximises
+  double densityErrorAvg = 0, densityErrorMax = 0, kineticEnergyEnd = 0;
+  std::vector<int> frame;
+  std::vector<double> time, frontX, backHeight;
+
+  // Against the reference run (NaN when not comparable).
+  bool reference = false;
+  double frontRms = 0, heightRms = 0, fieldError = 0, error = 0;
+};
+
+// Reads the run's stats.csv into it (the columns are found by name). A run that stopped early keeps its rows.
+void readRunStats(StudyRun& run);
+
+// Picks the reference (the ok run of most work, then most CPU seconds) and fills every run's accuracy figures.
+// damBreak: error is the RMS of front_x and back_height against the reference over time; otherwise it is the
+// particle-density field difference at the final frame (fieldError is computed for every scene). Returns the reference's position in runs, or -1.
+int compareWithReference(std::vector<StudyRun>& runs, bool damBreak, const Box& domain, int dimensions);
+
+// study.csv, written atomically: one row per run.
+void writeStudyCsv(const fs::path& path, const std::vector<Sweep>& sweeps, const std::vector<StudyRun>& runs);
+
+// error_vs_cpu.png (Pareto front marked) and front_vs_time.png in dir, through a gnuplot script (plots.gp).
+// Returns an empty string, or a one-line warning when gnuplot is missing or failed (the study still succeeds).
+std::string writeStudyPlots(const fs::path& dir, const std::vector<Sweep>& sweeps, const std::vector<StudyRun>& runs,
+                            int reference, bool damBreak);
+
+// The runs on the Pareto front of (CPU seconds, error): none cheaper is at least as accurate. Sorted by CPU.
+std::vector<int> paretoFront(const std::vector<StudyRun>& runs);
+
+}  // namespace surge
