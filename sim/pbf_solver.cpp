@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/parallel.h"
+#include "sim/particle_channels.h"
 #include "sim/tank.h"
 
 namespace surge {
@@ -22,10 +23,6 @@ double millisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-template <int Dim>
-Vec<Dim> toVec(const Eigen::Vector3d& v) {
-  return v.head<Dim>().template cast<float>();
-}
 
 }  // namespace
 
@@ -71,31 +68,16 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene)
 
 template <int Dim>
 void PbfSolver<Dim>::setParticles(const ParticleFrame& frame) {
+  readChannels(frame, x_, v_, id_);
   const size_t n = frame.size();
-  x_.resize(n);
-  v_.resize(n);
   p_.resize(n);
-  id_ = frame.id;
   lambda_.assign(n, 0.0f);
-  for (size_t i = 0; i < n; ++i) {
-    x_[i] = frame.position[i].head<Dim>();
-    v_[i] = frame.velocity[i].head<Dim>();
-  }
   if (vorticityEpsilon_ > 0) (Dim == 3 ? omega3_.resize(n) : omega2_.resize(n));
 }
 
 template <int Dim>
 void PbfSolver<Dim>::getParticles(ParticleFrame& frame) const {
-  const size_t n = x_.size();
-  frame.dimensions = Dim;
-  frame.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    frame.position[i].setZero();
-    frame.velocity[i].setZero();
-    frame.position[i].head<Dim>() = x_[i];
-    frame.velocity[i].head<Dim>() = v_[i];
-  }
-  frame.id = id_;
+  writeChannels(x_, v_, id_, frame);
 }
 
 template <int Dim>

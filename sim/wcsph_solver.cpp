@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/parallel.h"
+#include "sim/particle_channels.h"
 
 namespace surge {
 namespace {
@@ -13,10 +14,6 @@ double millisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-template <int Dim>
-Vec<Dim> toVec(const Eigen::Vector3d& v) {
-  return v.head<Dim>().template cast<float>();
-}
 
 // The tank's walls seen through the scene's kernel.
 template <int Dim>
@@ -73,33 +70,18 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene)
 
 template <int Dim>
 void WcsphSolver<Dim>::setParticles(const ParticleFrame& frame) {
+  readChannels(frame, x_, v_, id_);
   const size_t n = frame.size();
-  x_.resize(n);
-  v_.resize(n);
   a_.assign(n, VecD::Zero());
-  id_ = frame.id;
   density_.assign(n, restDensity_);
   pressure_.assign(n, 0.0f);
   if (nearStiffness_ > 0) nearPressure_.assign(n, 0.0f);
-  for (size_t i = 0; i < n; ++i) {
-    x_[i] = frame.position[i].head<Dim>();
-    v_[i] = frame.velocity[i].head<Dim>();
-  }
   accelerationsValid_ = false;
 }
 
 template <int Dim>
 void WcsphSolver<Dim>::getParticles(ParticleFrame& frame) const {
-  const size_t n = x_.size();
-  frame.dimensions = Dim;
-  frame.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    frame.position[i].setZero();
-    frame.velocity[i].setZero();
-    frame.position[i].head<Dim>() = x_[i];
-    frame.velocity[i].head<Dim>() = v_[i];
-  }
-  frame.id = id_;
+  writeChannels(x_, v_, id_, frame);
 }
 
 template <int Dim>
