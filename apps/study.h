@@ -41,6 +41,7 @@ struct StudyRun {
 
   // Against the reference run (NaN when not comparable).
   bool reference = false;
+  double window = 0;  // front and height compared over [0, window] s: until the reference's front hits the far wall
   double frontRms = 0, heightRms = 0, fieldError = 0, error = 0;
 };
 

@@ -1,0 +1,222 @@
+// The extremes matrix (issue 7): settings at the edges of what the scene check allows, for both solvers, run as a
+// user runs them (`surge sim` in a child process). Each case must end in one of two ways:
+//   - exit 0, every frame 0..output.frames present, all with the scene's particle count, every position and
+//     velocity finite and every position inside the tank;
+//   - a clean stop: exit 1 and the one line "surge: simulation diverged at frame F, substep S: particle ...",
+//     frames 0..F-1 present and valid as above, nothing after them.
+// Anything else (a crash, a hang past ctest's timeout, NaN or a particle outside the tank in a written frame, a
+// frame missing, another message) fails. The cases are 3D (the harder neighbour sums and the memory of real
+// scenes) on a small tank so that the whole matrix takes about two minutes on two cores.
+//
+// WCSPH has no substeps or iterations; its cases map them onto its own knobs:
+//   one substep per frame  -> solver.time_step = 1/30 s, a fixed step of a whole frame (far beyond its CFL limit);
+//   one iteration          -> solver.cfl = 1, the largest step the key's range allows (least work per frame);
+//   100 iterations         -> speed_of_sound 10 x its default: 100 x the stiffness (p ~ c^2) and 10 x the steps,
+//                             the "make it incompressible by brute force" end, as 100 iterations are for PBF.
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fcntl.h>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "core/errors.h"
+#include "core/ply.h"
+#include "core/scene.h"
+
+extern char** environ;
+
+namespace surge {
+namespace {
+
+// 15 x 15 x 8 = 1,800 particles against the left wall of a 1 x 0.5 x 0.16 m tank: a small dam break.
+const char* kBase = R"({
+  "name": "extreme", "dimensions": 3,
+  "domain": {"min": [0, 0, 0], "max": [1.0, 0.5, 0.16]},
+  "particle_spacing": 0.02,
+  "fluids": [{"box": {"min": [0, 0, 0], "max": [0.3, 0.3, 0.16]}}],
+  "output": {"fps": 30, "frames": 30}
+})";
+
+struct ExtremeCase {
+  std::string name;
+  std::vector<std::string> pbf, wcsph;  // --set assignments per solver (plus solver.method)
+};
+
+std::string box(const std::string& min, const std::string& max, const std::string& velocity = "") {
+  return R"({"box": {"min": )" + min + R"(, "max": )" + max + "}" +
+         (velocity.empty() ? "" : R"(, "velocity": )" + velocity) + "}";
+}
+
+// The largest 3D particle count whose memory estimate fits in 2 GiB, as a cube of n^3 lattice points.
+int largestCube() {
+  const double most = double(size_t(1) << 31) / double(bytesPerParticleEstimate(3));
+  int n = static_cast<int>(std::cbrt(most));
+  while (double(n + 1) * (n + 1) * (n + 1) <= most) ++n;
+  while (double(n) * n * n > most) --n;
+  return n;
+}
+
+// The smallest particle spacing the scene check allows for a tank 1 m long: the grid may span at most 2^20
+// kernel radii (2 spacings) along an axis. (The memory check bounds the particle count, not the spacing: a
+// spacing at the memory limit is the LargestCount case.) At 4.8e-7 m the lattice is a few float ulps apart
+// near 1 m, which is why the fluid sits at the origin, where floats are fine; gravity moves it
+// thousands of spacings per step.
+const double kSmallestSpacing = 1.0 / double(1 << 21);
+
+std::string number(double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+std::vector<ExtremeCase> cases() {
+  const std::string tiny = number(kSmallestSpacing), tenTiny = number(10 * kSmallestSpacing);
+  const int n = largestCube();
+  const std::string big = number(n * 0.01);  // spacing 0.01: an n^3 block
+  return {
+      {"OneSubstepPerFrame", {"solver.substeps=1", "output.fps=30"}, {"solver.time_step=" + number(1.0 / 30), "output.fps=30"}},
+      {"OneIteration", {"solver.iterations=1"}, {"solver.cfl=1"}},
+      // 100 iterations are 25 x the default's work: 10 frames keep it to seconds.
+      {"HundredIterations", {"solver.iterations=100", "output.frames=10"},
+       {"solver.speed_of_sound=313.2", "output.frames=10"}},  // 10 x the default 10 x sqrt(2 g 0.5 m)
+      // A block thrown at 30 m/s into the right wall, which it reaches in 12 ms.
+      {"ThrownAt30MetresPerSecond",
+       {"fluids=[" + box("[0.4, 0.1, 0]", "[0.6, 0.3, 0.16]", "[30, 0, 0]") + "]", "output.frames=6"},
+       {"fluids=[" + box("[0.4, 0.1, 0]", "[0.6, 0.3, 0.16]", "[30, 0, 0]") + "]", "output.frames=6"}},
+      {"DomainTenToOneLong", {"domain.max=[5.0, 0.5, 0.16]"}, {"domain.max=[5.0, 0.5, 0.16]"}},
+      {"SingleParticle",
+       {"fluids=[" + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "]"},
+       {"fluids=[" + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "]"}},
+      {"TwoParticlesOnTopOfEachOther",
+       {"fluids=[" + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "," + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "]"},
+       {"fluids=[" + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "," + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "]"}},
+      // A 10 x 10 x 10 block at the smallest spacing; 3 frames.
+      {"SmallestSpacing",
+       {"particle_spacing=" + tiny, "fluids=[" + box("[0, 0, 0]", "[" + tenTiny + "," + tenTiny + "," + tenTiny + "]") + "]",
+        "output.frames=3"},
+       {"particle_spacing=" + tiny, "fluids=[" + box("[0, 0, 0]", "[" + tenTiny + "," + tenTiny + "," + tenTiny + "]") + "]",
+        "output.frames=3"}},
+      // n^3 particles (8.2 million), one frame of one step and one iteration: the memory and the size of the
+      // arrays, not the physics, are under test. The tank is twice the block's width.
+      {"LargestCountIn2GiB",
+       {"particle_spacing=0.01", "domain.max=[" + number(2 * n * 0.01) + "," + number(1.5 * n * 0.01) + "," + big + "]",
+        "fluids=[" + box("[0, 0, 0]", "[" + big + "," + big + "," + big + "]") + "]", "output.frames=1", "solver.substeps=1",
+        "solver.iterations=1"},
+       {"particle_spacing=0.01", "domain.max=[" + number(2 * n * 0.01) + "," + number(1.5 * n * 0.01) + "," + big + "]",
+        "fluids=[" + box("[0, 0, 0]", "[" + big + "," + big + "," + big + "]") + "]", "output.frames=1",
+        "solver.time_step=0.00005", "output.fps=20000"}},
+  };
+}
+
+struct ChildResult {
+  int status = -1;
+  std::string err;
+  long peakKilobytes = 0;
+};
+
+// Runs `surge sim` with stdout and stderr into files, and its peak memory from wait4.
+ChildResult runSim(const fs::path& scene, const fs::path& out, const std::vector<std::string>& sets) {
+  std::vector<std::string> args = {SURGE_BINARY, "sim", scene.string(), "--quiet", "--out", out.string()};
+  for (const std::string& set : sets) args.insert(args.end(), {"--set", set});
+  std::vector<char*> argv;
+  for (std::string& arg : args) argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  const std::string errPath = (out.parent_path() / (out.filename().string() + ".err")).string();
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&files, STDERR_FILENO, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = 0;
+  ChildResult result;
+  const int spawned = posix_spawn(&pid, args[0].c_str(), &files, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&files);
+  if (spawned != 0) return result;
+  int status = 0;
+  rusage usage{};
+  wait4(pid, &status, 0, &usage);
+  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.peakKilobytes = usage.ru_maxrss;
+  result.err = readTextFile(errPath);
+  return result;
+}
+
+// Every particle of the frame finite and inside the tank (the solver's own test, in float, as it stores them).
+void expectValidFrame(const ParticleFrame& frame, const Scene& scene, size_t particles, int number) {
+  ASSERT_EQ(frame.size(), particles) << "frame " << number;
+  const Eigen::Vector3f min = scene.domain.min.cast<float>(), max = scene.domain.max.cast<float>();
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const Eigen::Vector3f& p = frame.position[i];
+    ASSERT_TRUE(p.allFinite() && frame.velocity[i].allFinite()) << "frame " << number << ", particle " << i;
+    for (int k = 0; k < scene.dimensions; ++k)
+      ASSERT_TRUE(p[k] >= min[k] && p[k] <= max[k])
+          << "frame " << number << ", particle " << i << " outside the tank on axis " << k << ": " << p[k];
+  }
+}
+
+class Extremes : public testing::TestWithParam<std::tuple<ExtremeCase, std::string>> {};
+
+TEST_P(Extremes, FiniteInsideTheTankOrACleanStop) {
+  const ExtremeCase& c = std::get<0>(GetParam());
+  const std::string& method = std::get<1>(GetParam());
+  std::vector<std::string> sets = method == "pbf" ? c.pbf : c.wcsph;
+  sets.push_back("solver.method=" + method);
+  const std::string name = std::to_string(::getpid()) + "_extreme_" + c.name + "_" + method;
+  const fs::path scenePath = fs::path(testing::TempDir()) / (name + ".json");
+  std::ofstream(scenePath) << kBase;
+  const fs::path out = fs::path(testing::TempDir()) / name;
+  fs::remove_all(out);
+  const Scene scene = loadScene(scenePath, sets);  // the case itself must pass the scene check
+  const size_t particles = scene.particleCount();
+
+  const ChildResult r = runSim(scenePath, out, sets);
+  RecordProperty("exit_status", r.status);
+  RecordProperty("peak_mb", std::to_string(r.peakKilobytes / 1024));
+  std::printf("%s/%s: exit %d, %zu particles, peak %.0f MB%s%s", c.name.c_str(), method.c_str(), r.status, particles,
+              r.peakKilobytes / 1024.0, r.err.empty() ? "\n" : ", ", r.err.c_str());
+  const std::vector<int> frames = listFrames(out, "particles", "ply");
+  int last = scene.output.frames;
+  if (r.status == kExitFailure) {
+    const std::string prefix = "surge: simulation diverged at frame ";
+    ASSERT_EQ(r.err.rfind(prefix, 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(", substep "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(": particle "), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    last = std::atoi(r.err.c_str() + prefix.size()) - 1;
+    ASSERT_GE(last, 0) << r.err;
+  } else {
+    ASSERT_EQ(r.status, kExitOk) << r.err;
+  }
+  std::vector<int> expected;
+  for (int f = 0; f <= last; ++f) expected.push_back(f);
+  ASSERT_EQ(frames, expected);
+  for (int f : frames) expectValidFrame(readParticlePly(framePath(out, "particles", f, "ply")), scene, particles, f);
+  fs::remove_all(out);  // the largest case leaves half a gigabyte
+}
+
+std::string caseName(const testing::TestParamInfo<Extremes::ParamType>& info) {
+  return std::get<0>(info.param).name + "_" + std::get<1>(info.param);
+}
+
+INSTANTIATE_TEST_SUITE_P(Matrix, Extremes, testing::Combine(testing::ValuesIn(cases()), testing::Values("pbf", "wcsph")),
+                         caseName);
+
+// The cases sit at the edges, not past them: the scene check refuses a little further.
+TEST(ExtremesEdges, OneStepPastEachEdgeIsRefused) {
+  const fs::path scenePath = fs::path(testing::TempDir()) / (std::to_string(::getpid()) + "_extreme_edges.json");
+  std::ofstream(scenePath) << kBase;
+  const std::string smaller = number(kSmallestSpacing * (1 - 1e-9));
+  EXPECT_NO_THROW(loadScene(scenePath, {"particle_spacing=" + number(kSmallestSpacing), "fluids=[" +
+                                            box("[0, 0, 0]", "[1e-5, 1e-5, 1e-5]") + "]"}));
+  EXPECT_THROW(loadScene(scenePath, {"particle_spacing=" + smaller, "fluids=[" + box("[0, 0, 0]", "[1e-5, 1e-5, 1e-5]") + "]"}),
+               InputError);
+}
+
+}  // namespace
+}  // namespace surge
