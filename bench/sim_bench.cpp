@@ -2,7 +2,9 @@
 //   particle_iterations/s  particles x substeps x iterations per CPU-second of all threads (per core),
 //                          over whole steps (all phases); the Time column is process CPU time
 //   bytes_per_particle     the process's peak resident memory, less what it held before the scene was made,
-//                          over the particle count (includes the initial particle frame and every channel)
+//                          over the particle count (includes the initial particle frame and every channel;
+//                          only meaningful for the first run of a size: the peak is the process's)
+//   solver_bytes_per_particle  what the solver holds after the run (capacities of all its arrays), exact
 // Run: build/bench/surge_bench_sim [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
@@ -69,6 +71,7 @@ void BM_PbfDamBreak(benchmark::State& state) {
   state.counters["particle_iterations/s"] =
       benchmark::Counter(static_cast<double>(iterations * solver.size()), benchmark::Counter::kIsRate);
   state.counters["bytes_per_particle"] = static_cast<double>(peakResidentBytes() - baseline) / solver.size();
+  state.counters["solver_bytes_per_particle"] = static_cast<double>(solver.memoryBytes()) / solver.size();
 }
 BENCHMARK(BM_PbfDamBreak)
     ->Args({100000, 1})

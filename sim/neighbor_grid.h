@@ -32,6 +32,11 @@ struct NeighborLists {
   const uint32_t* begin(size_t i) const { return chunks[i / kChunk].data() + start(i); }
   const uint32_t* end(size_t i) const { return chunks[i / kChunk].data() + ends[i]; }
   size_t count(size_t i) const { return end(i) - begin(i); }
+  size_t memoryBytes() const {
+    size_t bytes = ends.capacity() * sizeof(uint32_t);
+    for (const auto& chunk : chunks) bytes += chunk.capacity() * sizeof(uint32_t);
+    return bytes;
+  }
   size_t total() const {
     size_t sum = 0;
     for (size_t i = kChunk - 1; i < ends.size(); i += kChunk) sum += ends[i];
@@ -56,6 +61,10 @@ class NeighborGrid {
 
   // Cells of the last sort's box, and whether it used the sparse (sorted keys) path.
   uint64_t cellCount() const { return cellCount_; }
+  size_t memoryBytes() const {
+    return cellStart_.capacity() * 4 + cellKeys_.capacity() * 8 + sparseStart_.capacity() * 4 +
+           cellOfParticle_.capacity() * 4 + keyOfParticle_.capacity() * 8 + order_.capacity() * 4;
+  }
   bool sparse() const { return sparse_; }
 
  private:

@@ -330,6 +330,15 @@ FluidMeasures PbfSolver<Dim>::measure() {
                                       [&](float r2) { return kernels_.poly6(r2); });
 }
 
+template <int Dim>
+size_t PbfSolver<Dim>::memoryBytes() const {
+  size_t bytes = (x_.capacity() + v_.capacity() + p_.capacity() + scratch_.capacity() + omega3_.capacity()) * sizeof(VecD);
+  bytes += (id_.capacity() + scratchIds_.capacity()) * sizeof(uint32_t);
+  bytes += (lambda_.capacity() + omega2_.capacity()) * sizeof(float);
+  for (const auto& factors : pairGradientFactors_) bytes += factors.capacity() * sizeof(float);
+  return bytes + grid_.memoryBytes() + neighbors_.memoryBytes();
+}
+
 template class PbfSolver<2>;
 template class PbfSolver<3>;
 

@@ -53,6 +53,8 @@ class PbfSolver {
   uint32_t particleId(size_t i) const { return id_[i]; }
   float particleMass() const { return mass_; }
   const std::vector<VecD>& positions() const { return x_; }
+  // Bytes held by every particle channel, the grid, the neighbour lists and the pair factors (capacities).
+  size_t memoryBytes() const;
 
  private:
   void predictPositions(float dt, double time);
