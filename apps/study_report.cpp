@@ -57,11 +57,11 @@ std::vector<double> densityField(const ParticleFrame& frame, const Box& domain, 
   const Eigen::Vector3d extent = domain.max - domain.min;
   const double longest = dimensions == 2 ? std::max(extent.x(), extent.y()) : extent.maxCoeff();
   const double cell = longest / 32;
-  Eigen::Array3i n(1, 1, 1);
+  int n[3] = {1, 1, 1};
   for (int k = 0; k < dimensions; ++k) n[k] = std::max(1, int(std::ceil(extent[k] / cell - 1e-9)));
-  std::vector<double> field(size_t(n.prod()), 0.0);
+  std::vector<double> field(size_t(n[0]) * size_t(n[1]) * size_t(n[2]), 0.0);
   for (const Eigen::Vector3f& p : frame.position) {
-    Eigen::Array3i c(0, 0, 0);
+    int c[3] = {0, 0, 0};
     for (int k = 0; k < dimensions; ++k) c[k] = std::clamp(int((p[k] - domain.min[k]) / cell), 0, n[k] - 1);
     field[size_t((c[2] * n[1] + c[1]) * n[0] + c[0])] += 1.0 / double(frame.size());
   }

@@ -413,9 +413,11 @@ size_t Scene::particleCount() const {
 }
 
 size_t bytesPerParticleEstimate(int dimensions) {
-  // PBF: position, velocity, predicted position (3 x 12), lambda, density, id, cell (4 x 4), the sort's scratch
-  // copy (40), and about 40 neighbours of 4 bytes each in 3D (about 13 in 2D).
-  return dimensions == 3 ? 36 + 16 + 40 + 160 + 8 : 36 + 16 + 40 + 52 + 8;
+  // Measured peaks of the hungrier solver, PBF (the extremes tests and bench/sim_bench.cpp): in 3D about 340
+  // bytes of solver arrays (positions, velocities, predictions and their scratch copy 4 x 12; ids, lambdas and
+  // the grid's 16; about 30 neighbours and their stored gradient factors at 4 bytes each, with slack, 280), the
+  // 28-byte frame being written, and room for the allocator: 400. In 2D, 13 neighbours instead of 30: 250.
+  return dimensions == 3 ? 400 : 250;
 }
 
 Scene parseScene(const std::string& text, const std::string& where, const std::vector<std::string>& overrides) {

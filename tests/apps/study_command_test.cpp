@@ -1,0 +1,110 @@
+// `surge study` as a user runs it: a small sweep, its study.csv and plots; bad sweeps refused before anything is
+// written; and the dam-break columns of stats.csv.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "tests/apps/run_surge.h"
+
+namespace surge {
+namespace {
+
+// 2D, 20 x 20 = 400 particles against the left wall, 10 frames: a fraction of a second per run.
+const char* kTinyDamBreak = R"({
+  "name": "tiny", "dimensions": 2,
+  "domain": {"min": [0, 0], "max": [1.2, 0.6]},
+  "particle_spacing": 0.02,
+  "fluids": [{"box": {"min": [0, 0], "max": [0.4, 0.4]}}],
+  "output": {"fps": 30, "frames": 10}
+})";
+
+std::vector<std::vector<std::string>> readCsv(const fs::path& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> row;
+    std::string field;
+    bool quoted = false;
+    for (char c : line) {
+      if (c == '"') quoted = !quoted;
+      else if (c == ',' && !quoted) row.push_back(field), field.clear();
+      else field += c;
+    }
+    row.push_back(field);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+int column(const std::vector<std::string>& header, const std::string& name) {
+  const auto at = std::find(header.begin(), header.end(), name);
+  return at == header.end() ? -1 : int(at - header.begin());
+}
+
+TEST(StudyCommand, SweepWritesOneRowPerRunAndPicksTheCostliestAsReference) {
+  const fs::path scene = writeTestScene("tiny.json", kTinyDamBreak);
+  const fs::path out = fs::path(testing::TempDir()) / "surge_study";
+  fs::remove_all(out);
+  const SurgeResult r = runSurge("study '" + scene.string() + "' --quiet --sweep solver.iterations=1,4 --sweep " +
+                                 "solver.substeps=1,3 --frames 8 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = readCsv(out / "study.csv");
+  ASSERT_EQ(rows.size(), 5u);
+  const auto& header = rows[0];
+  const int iterations = column(header, "solver.iterations"), substeps = column(header, "solver.substeps");
+  const int reference = column(header, "reference"), error = column(header, "error"), steps = column(header, "steps");
+  const int cpu = column(header, "cpu_seconds"), peak = column(header, "peak_mb"), status = column(header, "status");
+  ASSERT_GE(std::min({iterations, substeps, reference, error, steps, cpu, peak, status}), 0);
+  // The first sweep varies slowest.
+  EXPECT_EQ(rows[1][iterations] + rows[1][substeps] + rows[2][substeps] + rows[3][iterations], "1134");
+  for (size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i][status], "ok");
+    EXPECT_EQ(std::stoi(rows[i][steps]), 8 * std::stoi(rows[i][substeps]));
+    EXPECT_GT(std::stod(rows[i][cpu]), 0);
+    EXPECT_GT(std::stod(rows[i][peak]), 1);
+    // The reference (4 iterations, 3 substeps: the most work) compares as 0; the others differ from it.
+    EXPECT_EQ(rows[i][reference], i == 4 ? "1" : "0");
+    if (i == 4) EXPECT_LT(std::stod(rows[i][error]), 1e-9);
+    else EXPECT_GT(std::stod(rows[i][error]), 1e-6);
+  }
+  EXPECT_TRUE(fs::exists(out / "runs" / "003_solver.iterations=4,solver.substeps=3" / "stats.csv"));
+}
+
+TEST(StudyCommand, BadSweepsAreRefusedBeforeAnythingIsWritten) {
+  const fs::path scene = writeTestScene("tiny.json", kTinyDamBreak);
+  const fs::path out = fs::path(testing::TempDir()) / "surge_study_bad";
+  fs::remove_all(out);
+  for (const std::string sweep : {"solver.iterations", "=1,2", "solver.iterations=1,,2", "solver.no_such_key=1,2",
+                                  "solver.iterations=1,0"}) {
+    const SurgeResult r = runSurge("study '" + scene.string() + "' --quiet --sweep '" + sweep + "' --out " + out.string());
+    EXPECT_EQ(r.status, 2) << sweep << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << sweep;
+  }
+}
+
+TEST(StudyCommand, StatsCarryFrontAndBackHeightOfTheDamBreak) {
+  // At rest the measures read the box exactly (the edge particle's centre plus the particle radius); then the
+  // front advances and the column drops. Against the right wall they read the same (distances from that wall).
+  for (const std::string side : {"left", "right"}) {
+    const fs::path scene = writeTestScene("tiny.json", kTinyDamBreak);
+    const fs::path out = fs::path(testing::TempDir()) / ("surge_front_" + side);
+    fs::remove_all(out);
+    const std::string set = side == "right" ? " --set 'fluids[0].box.min=[0.8,0]' --set 'fluids[0].box.max=[1.2,0.4]'" : "";
+    ASSERT_EQ(runSurge("sim '" + scene.string() + "' --quiet --out " + out.string() + set).status, 0);
+    const auto rows = readCsv(out / "stats.csv");
+    ASSERT_EQ(rows.size(), 12u);
+    const int front = column(rows[0], "front_x"), height = column(rows[0], "back_height");
+    ASSERT_EQ(front, int(rows[0].size()) - 2);  // appended at the end: earlier columns keep their positions
+    ASSERT_EQ(height, int(rows[0].size()) - 1);
+    EXPECT_NEAR(std::stod(rows[1][front]), 0.4, 1e-6) << side;
+    EXPECT_NEAR(std::stod(rows[1][height]), 0.4, 1e-6) << side;
+    EXPECT_GT(std::stod(rows[11][front]), 0.6) << side;   // 1/3 s: the front has run about 2 column heights
+    EXPECT_LT(std::stod(rows[11][height]), 0.35) << side;
+  }
+}
+
+}  // namespace
+}  // namespace surge
