@@ -26,9 +26,10 @@ awk -F, '
     wall = $3 + 0; cpu = $4 + 0
     if (name ~ /PbfDamBreak/) {
       n = counter("particles"); rate = counter("particle_iterations/s"); bytes = counter("bytes_per_particle")
+      solver = counter("solver_bytes_per_particle")
       split(name, parts, "/"); threads = parts[3]; sub("threads:", "", threads)
-      printf "| PBF dam break, %.0fk particles, %s thread(s) | %.2f M/s per core | >= 3 M/s per core | %.0f B | <= 400 B |\n", \
-        n / 1000, threads, rate / 1e6, bytes
+      printf "| PBF dam break, %.0fk particles, %s thread(s) | %.2f M/s per core | >= 3 M/s per core | %.0f B held, %.0f B peak RSS | <= 400 B |\n", \
+        n / 1000, threads, rate / 1e6, solver, bytes
     } else if (name ~ /GridRebuild/) {
       if (name ~ /piled:1/) piled = wall; else spread = wall
     } else if (name ~ /NeighborLists\/piled:0\/cells_per_radius:2/) { listsSpread = wall
