@@ -13,13 +13,10 @@ namespace surge {
 namespace {
 
 using testing::boxMesh;
+using testing::pixelAt;
 using testing::CountingProgress;
 using testing::TemporaryFolder;
 using testing::unitTankScene;
-
-const uint8_t* pixelAt(const Image& image, int x, int y) {
-  return &image.rgb[3 * (size_t(y) * image.width + x)];
-}
 
 TEST(RasterizerTest, DrawsTheWaterWhereTheMeshProjects) {
   const Scene scene = unitTankScene();

@@ -10,10 +10,16 @@
 #include "core/ply.h"
 #include "core/progress.h"
 #include "core/scene.h"
+#include "render/image.h"
 
 namespace surge::testing {
 
 // A unit tank with a small image; `renderExtra` is spliced into the "render" object.
+// The red, green and blue bytes of pixel (x, y).
+inline const uint8_t* pixelAt(const Image& image, int x, int y) {
+  return &image.rgb[3 * (size_t(y) * image.width + x)];
+}
+
 inline Scene unitTankScene(const std::string& renderExtra = "") {
   const std::string json = R"({
     "name": "render_test", "dimensions": 3,
