@@ -85,7 +85,8 @@ void WcsphSolver<Dim>::getParticles(ParticleFrame& frame) const {
 }
 
 template <int Dim>
-void WcsphSolver<Dim>::beginFrame(double) {
+void WcsphSolver<Dim>::beginFrame(double time) {
+  time_ = time;
   accelerationsValid_ = false;
   framePressureMax_ = 0;
 }
@@ -97,7 +98,7 @@ template <int Dim>
 float WcsphSolver<Dim>::stableTimeStep() {
   if (fixedStep_ > 0) return fixedStep_;
   if (!accelerationsValid_) {
-    computeAccelerations(0.0);  // at the frame's start; the time only moves the attractor, see step()
+    computeAccelerations(time_);  // the state's time: step() then uses these accelerations as a(x_n)
   }
   struct Maxima {
     float speed = 0, acceleration = 0;
@@ -156,6 +157,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     drift(dt);
     accelerationsValid_ = false;
   }
+  time_ = time + dt;
   return firstParticleOutside(x_, v_, walls_);
 }
 
@@ -248,7 +250,7 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
 
 template <int Dim>
 FluidMeasures WcsphSolver<Dim>::measure() {
-  if (neighbors_.size() != size()) computeAccelerations(0.0);
+  if (neighbors_.size() != size()) computeAccelerations(time_);
   auto sums = [&](const auto& kernel) {
     return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, walls_, mass_, restDensity_,
                                         [&](float r2) { return kernel.value(std::sqrt(r2)); });

@@ -84,6 +84,7 @@ class WcsphSolver {
   NeighborLists neighbors_;
 
   bool accelerationsValid_ = false;
+  double time_ = 0;  // the simulated time of the current state (moves the attractor)
   float framePressureMax_ = 0;
   PhaseTimes times_;
 };

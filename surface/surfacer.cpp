@@ -42,9 +42,6 @@ constexpr double kHalfWidthVoxels = 3.0;
 // along z (z = -3h .. +3h): a closed solid about 7 spacings thick once eroded, thick enough that the two
 // faces of the slab never merge under smoothing, and thin enough to cost only 7x the spheres of the frame.
 constexpr int kSlabHalfLayers = 3;
-// Mean-curvature flow steps (surface.smoothing_steps, default 2): enough to take out the bumps of the sphere
-// union (on a flat face they go from 0.04 to 0.004 spacings rms in two steps; each step moves the surface by
-// a third of a voxel times its curvature in voxels), few enough to keep edges and small droplets.
 // How far below the sphere tops (in spacings) the smoothed union of spheres of radius = spacing lies on a flat
 // face of a square lattice, measured: with it, the faces of a 20x10x10 block's mesh land within 0.002
 // spacings of the fluid's faces (measured with the re-distancing below; it was 0.15 with three Eikonal
@@ -293,6 +290,9 @@ FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
   // Smooth first, erode second: mean-curvature flow fills the dents between the spheres and rounds the sphere
   // caps, the erosion then takes the surface back to the fluid. (Eroding first would leave a lone particle
   // a sphere of one voxel, which smoothing then erases.)
+  // Mean-curvature flow steps (surface.smoothing_steps, default 2): enough to take out the bumps of the sphere
+  // union (on a flat face they go from 0.04 to 0.004 spacings rms in two steps; each step moves the surface by
+  // a third of a voxel times its curvature in voxels), few enough to keep edges and small droplets.
   for (int i = 0; i < scene.surface.smoothing_steps; ++i) filter.meanCurvature();
   // Positive offsets shrink the level set (phi + offset, phi < 0 inside).
   const double erosion = erosionOf(p);

@@ -156,6 +156,28 @@ TEST(WcsphSolver, AttractorPullsTowardsItsPath) {
   EXPECT_GT(after[-20.0], after[0.0] + 0.01);
 }
 
+TEST(WcsphSolver, FirstStepOfAFrameFeelsTheAttractorWhereItIsThen) {
+  // The attractor is out of reach at t = 0 and arrives beside a resting particle at t = 1 s. The first step of
+  // the frame that starts at t = 1 (its step size asked for first, as the frame loop does) must kick with the
+  // force at t = 1 in both half-steps: v = dt a to within the particle's drift during the step (under 1e-6 of
+  // the distance to the centre, so 1e-3 is generous). Evaluating the first half-kick at t = 0 would give dt a / 2.
+  const Scene scene = scene2d(R"([{"box": {"min": [0.5, 0.6], "max": [0.52, 0.62]}}])",
+                              {"gravity=[0,0]", "attractor.radius=0.3", "attractor.strength=20",
+                               R"(attractor.keyframes=[{"time": 0, "position": [0.9, 0.9]},)"
+                               R"( {"time": 1, "position": [0.51, 0.51]}])"});
+  WcsphSolver<2> solver(scene);
+  solver.setParticles(initialParticles(scene));
+  const Vec<2> start = solver.positions()[0];
+  solver.beginFrame(1.0);
+  const float dt = solver.stableTimeStep();
+  ASSERT_EQ(solver.step(dt, 1.0), -1);
+  const Vec<2> centre(0.51f, 0.51f);
+  const float distance = (centre - start).norm();
+  const Vec<2> expected = dt * 20.0f * (1.0f - distance / 0.3f) / distance * (centre - start);
+  EXPECT_NEAR(solver.velocities()[0].x(), expected.x(), 1e-3 * expected.norm());
+  EXPECT_NEAR(solver.velocities()[0].y(), expected.y(), 1e-3 * expected.norm());
+}
+
 TEST(WcsphSolver, NoParticleEscapesAViolentDamBreak) {
   // A 2D dam thrown at 5 m/s into the far wall, one simulated second, both kernels, near pressure on:
   // every step keeps every particle finite and inside (step() returns -1, checked in simulateFor).
