@@ -168,10 +168,12 @@ SimulationSummary run(const Scene& scene, const fs::path& dir, bool resume, Prog
     }
     const FluidMeasures measures = solver.measure();
     solver.getParticles(frame);
-    writeParticlePly(framePath(dir, "particles", f, "ply"), frame);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart).count();
+    // The row first, the frame second: a run killed between them resumes from the frame before, whose rows
+    // are the ones kept, so stats.csv never misses a frame that is on disk.
     stats.add(statsRow(f, f * frameDuration, solver.size(), steps, double(iterations) / steps, measures, seconds,
                        solver.phaseTimes(), smallestStep, solver.maxPressure(), measureDamBreak(scene, frame)));
+    writeParticlePly(framePath(dir, "particles", f, "ply"), frame);
     progress.advance();
   }
   progress.finish();
