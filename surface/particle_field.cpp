@@ -20,7 +20,8 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr int64_t kKeyOffset = int64_t(1) << 20;
 
 uint64_t keyOf(const Eigen::Vector3i& b) {
-  return (uint64_t(b.x() + kKeyOffset) << 42) | (uint64_t(b.y() + kKeyOffset) << 21) | uint64_t(b.z() + kKeyOffset);
+  return (uint64_t(b.x() + kKeyOffset) << 42) | (uint64_t(b.y() + kKeyOffset) << 21) |
+         uint64_t(b.z() + kKeyOffset);
 }
 Eigen::Vector3i blockOfKey(uint64_t key) {
   const uint64_t mask = (uint64_t(1) << 21) - 1;
@@ -28,7 +29,9 @@ Eigen::Vector3i blockOfKey(uint64_t key) {
                          int(int64_t(key & mask) - kKeyOffset));
 }
 
-int floorDiv8(int i) { return i >= 0 ? i / 8 : -((-i + 7) / 8); }
+int floorDiv8(int i) {
+  return i >= 0 ? i / 8 : -((-i + 7) / 8);
+}
 
 // ZB05's kernel k(s) = (1 - s^2)^3 for s < 1, from s^2.
 float zbKernel(float s2) {
@@ -38,8 +41,8 @@ float zbKernel(float s2) {
 }
 
 struct Sorted {
-  std::vector<uint64_t> keys;     // occupied blocks, ascending
-  std::vector<uint32_t> start;    // particles of keys[b]: order[start[b] .. start[b + 1])
+  std::vector<uint64_t> keys;   // occupied blocks, ascending
+  std::vector<uint32_t> start;  // particles of keys[b]: order[start[b] .. start[b + 1])
   std::vector<uint32_t> order;
 };
 
@@ -67,6 +70,99 @@ Sorted sortByBlock(const std::vector<Eigen::Vector3f>& centre, double voxel) {
   return s;
 }
 
+// Spheres: acc[voxel] = min(acc[voxel], |x_voxel - x_i| - r) over the candidates i, for the voxels of block
+// origin o within `extent` of each centre.
+void stampSpheres(const std::vector<Eigen::Vector3f>& centre, const std::vector<uint32_t>& candidates,
+                  const Eigen::Vector3i& o, double v, float r, float extent, float* acc) {
+  const float extent2 = extent * extent;
+  float grid[3][kBlockDim];  // world coordinates of the block's voxel planes, as float(i * v)
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < kBlockDim; ++j) grid[k][j] = float((o[k] + j) * v);
+  for (uint32_t i : candidates) {
+    const Eigen::Vector3f& x = centre[i];
+    int lo[3], hi[3];
+    bool empty = false;
+    for (int k = 0; k < 3; ++k) {
+      const double q = double(x[k]) / v, e = double(extent) / v;
+      lo[k] = std::max(0, int(std::ceil(q - e)) - o[k]);
+      hi[k] = std::min(kBlockDim - 1, int(std::floor(q + e)) - o[k]);
+      empty |= lo[k] > hi[k];
+    }
+    if (empty) continue;
+    float dz2[kBlockDim];
+    for (int iz = lo[2]; iz <= hi[2]; ++iz) dz2[iz] = (grid[2][iz] - x.z()) * (grid[2][iz] - x.z());
+    for (int ix = lo[0]; ix <= hi[0]; ++ix) {
+      const float dx2 = (grid[0][ix] - x.x()) * (grid[0][ix] - x.x());
+      if (dx2 > extent2) continue;
+      for (int iy = lo[1]; iy <= hi[1]; ++iy) {
+        const float dxy2 = dx2 + (grid[1][iy] - x.y()) * (grid[1][iy] - x.y());
+        if (dxy2 > extent2) continue;
+        float* row = acc + (ix * kBlockDim + iy) * kBlockDim;
+        for (int iz = lo[2]; iz <= hi[2]; ++iz) row[iz] = std::min(row[iz], std::sqrt(dxy2 + dz2[iz]) - r);
+      }
+    }
+  }
+}
+
+// The weighted fields (SmoothSpheres, Anisotropic, Velocity): per voxel of the block at origin o, 4 sums
+// acc[4 a ..] over the candidates, in their order.
+void stampWeights(const FieldParticles& particles, const FieldParameters& p,
+                  const std::vector<Eigen::Vector3f>& centre, const std::vector<uint32_t>& candidates,
+                  const Eigen::Vector3i& o, double extentVoxels, float* acc) {
+  const double v = p.voxel;
+  const bool anisotropic = p.kind == FieldKind::Anisotropic;
+  const float invR2 = p.support > 0 ? float(1 / (p.support * p.support)) : 0.f;
+  const float sigma = float(315 / (64 * kPi));
+  for (uint32_t i : candidates) {
+    const Eigen::Vector3f& x = centre[i];
+    int lo[3], hi[3];
+    bool empty = false;
+    for (int k = 0; k < 3; ++k) {
+      const double q = double(x[k]) / v;
+      lo[k] = std::max(o[k], int(std::ceil(q - extentVoxels)));
+      hi[k] = std::min(o[k] + kBlockDim - 1, int(std::floor(q + extentVoxels)));
+      empty |= lo[k] > hi[k];
+    }
+    if (empty) continue;
+    const Eigen::Matrix3f* G = anisotropic ? &particles.kernels->G[i] : nullptr;
+    const float scale = anisotropic ? float(p.volume) * sigma * G->determinant() : 0.f;
+    const Eigen::Vector3f* vel = p.kind == FieldKind::Velocity ? &(*particles.velocity)[i] : nullptr;
+    for (int ix = lo[0]; ix <= hi[0]; ++ix)
+      for (int iy = lo[1]; iy <= hi[1]; ++iy)
+        for (int iz = lo[2]; iz <= hi[2]; ++iz) {
+          const Eigen::Vector3f d = Eigen::Vector3f(float(ix * v), float(iy * v), float(iz * v)) - x;
+          const int a = ((ix - o[0]) * kBlockDim + (iy - o[1])) * kBlockDim + (iz - o[2]);
+          switch (p.kind) {
+            case FieldKind::Spheres:  // stampSpheres
+              break;
+            case FieldKind::SmoothSpheres: {
+              const float w = zbKernel(d.squaredNorm() * invR2);
+              float* s = &acc[4 * a];
+              s[0] += w, s[1] += w * x.x(), s[2] += w * x.y(), s[3] += w * x.z();
+              break;
+            }
+            case FieldKind::Anisotropic: {
+              // f and its gradient: grad_x P(|G d|^2) = -6 (1 - q^2)^2 G^T G d, and G is symmetric.
+              const Eigen::Vector3f u = *G * d;
+              const float q2 = u.squaredNorm();
+              if (q2 >= 1) break;
+              const float w = 1 - q2;
+              const Eigen::Vector3f g = (-6 * scale * w * w) * (*G * u);
+              float* s = &acc[4 * a];
+              s[0] += scale * w * w * w, s[1] += g.x(), s[2] += g.y(), s[3] += g.z();
+              break;
+            }
+            case FieldKind::Velocity: {
+              const float w = zbKernel(d.squaredNorm() * invR2);
+              float* s = &acc[4 * a];
+              s[0] += w, s[1] += w * vel->x(), s[2] += w * vel->y(), s[3] += w * vel->z();
+              break;
+            }
+          }
+        }
+  }
+}
+
 }  // namespace
 
 BlockField rasterizeField(const FieldParticles& particles, const FieldParameters& p,
@@ -86,7 +182,8 @@ BlockField rasterizeField(const FieldParticles& particles, const FieldParameters
   const Sorted sorted = sortByBlock(centre, v);
   std::vector<uint64_t> targets;
   if (only) {
-    for (const auto& o : *only) targets.push_back(keyOf(Eigen::Vector3i(floorDiv8(o.x()), floorDiv8(o.y()), floorDiv8(o.z()))));
+    for (const auto& o : *only)
+      targets.push_back(keyOf(Eigen::Vector3i(floorDiv8(o.x()), floorDiv8(o.y()), floorDiv8(o.z()))));
   } else {
     targets.reserve(sorted.keys.size() * 8);
     for (uint64_t key : sorted.keys) {
@@ -108,7 +205,8 @@ BlockField rasterizeField(const FieldParticles& particles, const FieldParameters
   };
   if (skipInside) {
     occupied.resize(centre.size());
-    for (size_t i = 0; i < centre.size(); ++i) occupied[i] = cellKey(centre[i].x(), centre[i].y(), centre[i].z());
+    for (size_t i = 0; i < centre.size(); ++i)
+      occupied[i] = cellKey(centre[i].x(), centre[i].y(), centre[i].z());
     std::sort(occupied.begin(), occupied.end());
     occupied.erase(std::unique(occupied.begin(), occupied.end()), occupied.end());
   }
@@ -124,15 +222,15 @@ BlockField rasterizeField(const FieldParticles& particles, const FieldParameters
     for (int x = lo.x(); x <= hi.x(); ++x)
       for (int y = lo.y(); y <= hi.y(); ++y)
         for (int z = lo.z(); z <= hi.z(); ++z)
-          if (!std::binary_search(occupied.begin(), occupied.end(), keyOf(Eigen::Vector3i(x, y, z)))) return false;
+          if (!std::binary_search(occupied.begin(), occupied.end(), keyOf(Eigen::Vector3i(x, y, z))))
+            return false;
     return true;
   };
 
   const int channels = p.kind == FieldKind::Velocity ? 3 : 1;
   const bool distance = p.kind != FieldKind::Velocity;
   const float band = float(p.band);
-  const float r = float(p.radius), invR2 = p.support > 0 ? float(1 / (p.support * p.support)) : 0.f;
-  const float sigma = float(315 / (64 * kPi));
+  const float r = float(p.radius);
   std::vector<std::unique_ptr<float[]>> kept(targets.size());
 
   parallelFor(
@@ -155,63 +253,20 @@ BlockField rasterizeField(const FieldParticles& particles, const FieldParameters
                 candidates.insert(candidates.end(), sorted.order.begin() + sorted.start[s],
                                   sorted.order.begin() + sorted.start[s + 1]);
               }
-          // The neighbouring blocks come in key order, particles in index order within each: sort once more
-          // so the sum order is the particle order, independent of how the blocks were visited.
-          std::sort(candidates.begin(), candidates.end());
           if (candidates.empty() && !only) continue;
-
           std::fill(acc.begin(), acc.end(), 0.f);
-          if (p.kind == FieldKind::Spheres) std::fill(acc.begin(), acc.begin() + kBlockVoxels, band);
-          for (uint32_t i : candidates) {
-            const Eigen::Vector3f& x = centre[i];
-            int lo[3], hi[3];
-            bool empty = false;
-            for (int k = 0; k < 3; ++k) {
-              const double q = double(x[k]) / v;
-              lo[k] = std::max(o[k], int(std::ceil(q - extentVoxels)));
-              hi[k] = std::min(o[k] + kBlockDim - 1, int(std::floor(q + extentVoxels)));
-              empty |= lo[k] > hi[k];
-            }
-            if (empty) continue;
-            const Eigen::Matrix3f* G = anisotropic ? &particles.kernels->G[i] : nullptr;
-            const float scale = anisotropic ? float(p.volume) * sigma * G->determinant() : 0.f;
-            const Eigen::Vector3f* vel = p.kind == FieldKind::Velocity ? &(*particles.velocity)[i] : nullptr;
-            for (int ix = lo[0]; ix <= hi[0]; ++ix)
-              for (int iy = lo[1]; iy <= hi[1]; ++iy)
-                for (int iz = lo[2]; iz <= hi[2]; ++iz) {
-                  const Eigen::Vector3f d = Eigen::Vector3f(float(ix * v), float(iy * v), float(iz * v)) - x;
-                  const int a = ((ix - o[0]) * kBlockDim + (iy - o[1])) * kBlockDim + (iz - o[2]);
-                  switch (p.kind) {
-                    case FieldKind::Spheres:
-                      acc[a] = std::min(acc[a], d.norm() - r);
-                      break;
-                    case FieldKind::SmoothSpheres: {
-                      const float w = zbKernel(d.squaredNorm() * invR2);
-                      float* s = &acc[4 * a];
-                      s[0] += w, s[1] += w * x.x(), s[2] += w * x.y(), s[3] += w * x.z();
-                      break;
-                    }
-                    case FieldKind::Anisotropic: {
-                      // f and its gradient: grad_x P(|G d|^2) = -6 (1 - q^2)^2 G^T G d, and G is symmetric.
-                      const Eigen::Vector3f u = *G * d;
-                      const float q2 = u.squaredNorm();
-                      if (q2 >= 1) break;
-                      const float w = 1 - q2;
-                      const Eigen::Vector3f g = (-6 * scale * w * w) * (*G * u);
-                      float* s = &acc[4 * a];
-                      s[0] += scale * w * w * w, s[1] += g.x(), s[2] += g.y(), s[3] += g.z();
-                      break;
-                    }
-                    case FieldKind::Velocity: {
-                      const float w = zbKernel(d.squaredNorm() * invR2);
-                      float* s = &acc[4 * a];
-                      s[0] += w, s[1] += w * vel->x(), s[2] += w * vel->y(), s[3] += w * vel->z();
-                      break;
-                    }
-                  }
-                }
+          if (p.kind == FieldKind::Spheres) {
+            // A minimum is exact in any order, so the candidates need no sorting; the loops skip the corners
+            // of each particle's box beyond its extent (values there would be over the band, clamped anyway)
+            // and run along z innermost, which the compiler vectorises.
+            std::fill(acc.begin(), acc.begin() + kBlockVoxels, band);
+            stampSpheres(centre, candidates, o, v, r, float(extent), acc.data());
+          } else {
+            // The neighbouring blocks come in key order, particles in index order within each: sort once more
+            // so the sum order is the particle order, independent of how the blocks were visited.
+            std::sort(candidates.begin(), candidates.end());
+            stampWeights(particles, p, centre, candidates, o, extentVoxels, acc.data());
           }
-
           std::unique_ptr<float[]> values(new float[size_t(kBlockVoxels) * channels]);
           bool inBand = false;
           for (int a = 0; a < kBlockVoxels; ++a) {

@@ -2,22 +2,19 @@
 // OpenVDB's tools (40-55 s to compile); everything else sees only surfacer.h.
 //
 // Method: a raw level set from particle_field.h (union of spheres, Zhu & Bridson blend or Yu & Turk
-// anisotropic kernels, by surface.method), re-distanced (LevelSetTracker), smoothed by mean-curvature flow and
-// eroded back to the fluid's volume (tools::LevelSetFilter; the erosion added to the distances in one pass),
-// meshed by tools::volumeToMesh at isovalue 0.
+// anisotropic kernels, by surface.method), smoothed by mean-curvature flow and eroded back to the fluid's
+// volume, meshed by tools::volumeToMesh at isovalue 0. `spheres` runs its level-set steps on narrow_band.h's
+// dense blocks; the blended fields on tools::LevelSetFilter (re-distancing by LevelSetTracker).
 #include "surface/surfacer.h"
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
-#include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetFilter.h>
 #include <openvdb/tools/SignedFloodFill.h>
 #include <openvdb/tools/VolumeToMesh.h>
-#include <unistd.h>
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -28,6 +25,7 @@
 #include "core/errors.h"
 #include "core/parallel.h"
 #include "surface/anisotropy.h"
+#include "surface/narrow_band.h"
 #include "surface/particle_field.h"
 #include "surface/vdb_output.h"
 
@@ -42,22 +40,20 @@ constexpr double kHalfWidthVoxels = 3.0;
 // along z (z = -3h .. +3h): a closed solid about 7 spacings thick once eroded, thick enough that the two
 // faces of the slab never merge under smoothing, and thin enough to cost only 7x the spheres of the frame.
 constexpr int kSlabHalfLayers = 3;
-// How far below the sphere tops (in spacings) the smoothed union of spheres of radius = spacing lies on a flat
-// face of a square lattice, measured: with it, the faces of a 20x10x10 block's mesh land within 0.002
-// spacings of the fluid's faces (measured with the re-distancing below; it was 0.15 with three Eikonal
-// iterations after every smoothing step). For radii other than the spacing it is an approximation.
-constexpr double kDentFill = 0.17;
-// Eikonal iterations of the re-distancing: the band is 3 voxels each side and one iteration moves correct
-// distances about a voxel, so 3 reach across it (LevelSetTracker's default is 1, meant for a band already
-// nearly right after one step of motion).
+// How far below the sphere tops (in spacings) the smoothed union of spheres of radius = spacing lies on a
+// flat face of a square lattice, measured: with it, the faces of a 20x10x10 block's mesh land within 0.001
+// spacings of the fluid's faces (tests/surface: BandAcrossABlocksFaceIsASignedDistanceToTheFluidsFace; 0.17
+// with OpenVDB's re-distancing between the steps, 0.15 with three Eikonal iterations after every smoothing
+// step). For radii other than the spacing it is an approximation.
+constexpr double kDentFill = 0.205;
+// Eikonal iterations after the smoothing and after the shift: one carries right distances a voxel further out
+// from the surface (a third to a whole voxel, by the surface's orientation), and the steps before them leave
+// the band nearly a distance already, so 3, one per voxel of the band, suffice.
+constexpr int kRedistanceIterations = 3;
+// Eikonal iterations of OpenVDB's re-distancing for the blended fields: the band is 3 voxels each side and
+// one iteration moves correct distances about a voxel, so 3 reach across it (LevelSetTracker's default is 1,
+// meant for a band already nearly right after one step of motion).
 constexpr int kRenormalise = 3;
-// `spheres` gets a raw field whose inside is a distance already (chamferInside), so it needs only
-// kSpheresFirstIterations before smoothing and kSpheresErodeIterations in the erosion's track (against 3 and 6
-// for the other fields): 3.8 s instead of 6.6 s on the 1M-particle benchmark frame, with the band deeper
-// inside as true as before (docs/performance.md).
-constexpr int kChamferPasses = 4;
-constexpr int kSpheresFirstIterations = 1;
-constexpr int kSpheresErodeIterations = 2;
 
 void initOpenVdb() {
   static std::once_flag once;
@@ -71,13 +67,13 @@ constexpr double kZbSupport = 2.0;
 constexpr double kZbInset = 0.0;
 // Anisotropic (YT13): kernel support h = 2 spacings, PCA radius 3 spacings (YT13 take 2h; 3 spacings already
 // gives 60 neighbours to a particle of a flat face, above N_epsilon = 25, for a third of the cost), iso-value
-// half the rest field (f = 1 inside a fluid at rest, exactly: AnisotropicKernels::particleVolume; 0.5 is where
-// an unsmoothed half-space of fluid ends), and kAnisoInset: where that surface lies under the fluid's face
-// on the test block (20x10x10, every face), measured. The smoothed centres of the outer layer sit 0.62
+// half the rest field (f = 1 inside a fluid at rest, exactly: AnisotropicKernels::particleVolume; 0.5 is
+// where an unsmoothed half-space of fluid ends), and kAnisoInset: where that surface lies under the fluid's
+// face on the test block (20x10x10, every face), measured. The smoothed centres of the outer layer sit 0.62
 // spacings inside it and their kernels are flattened to 0.8 spacings across, so f = 0.5 lies 0.72 spacings
-// under the fluid's face after the smoothing steps (0.74 before); 0.753 puts the faces within 0.001 spacings of
-// the fluid's (the rest of the 2.7% that the block loses is at its edges and corners, where the centres move
-// inward along two or three axes). The level set is dilated by that much after smoothing.
+// under the fluid's face after the smoothing steps (0.74 before); 0.753 puts the faces within 0.001 spacings
+// of the fluid's (the rest of the 2.7% that the block loses is at its edges and corners, where the centres
+// move inward along two or three axes). The level set is dilated by that much after smoothing.
 constexpr double kAnisoSupport = 2.0;
 constexpr double kAnisoPca = 3.0;
 constexpr double kAnisoIso = 0.5;
@@ -122,78 +118,33 @@ std::vector<Eigen::Vector3f> slabPositions(const ParticleFrame& frame, const Par
   return out;
 }
 
-// A level set from blocks of distances (particle_field.h): one leaf per block, every voxel of it active, the
-// tiles around them given their sign by a flood fill (blocks wholly inside were never made).
-FloatGrid::Ptr gridFromBlocks(const BlockField& blocks, double voxel) {
+// A level set from blocks of distances (particle_field.h): one leaf per block, the tiles around them given
+// their sign by a flood fill (blocks wholly inside were never made). With `trim`, values are clamped to
+// +-band and only the voxels inside (-band, band) are active, blocks with none of them dropped (a finished
+// level set); without, every voxel of a block is active (a raw field for OpenVDB's re-distancing).
+FloatGrid::Ptr gridFromBlocks(const BlockField& blocks, double voxel, bool trim) {
   FloatGrid::Ptr grid = emptyLevelSet(voxel);
   auto& tree = grid->tree();
+  const float band = float(kHalfWidthVoxels * voxel);
   for (size_t b = 0; b < blocks.origins.size(); ++b) {
     const Eigen::Vector3i& o = blocks.origins[b];
-    auto* leaf = new FloatGrid::TreeType::LeafNodeType(openvdb::Coord(o.x(), o.y(), o.z()), 0.f, true);
-    std::copy(blocks.values.begin() + ptrdiff_t(b * kBlockVoxels),
-              blocks.values.begin() + ptrdiff_t((b + 1) * kBlockVoxels), leaf->buffer().data());
+    const float* values = &blocks.values[b * kBlockVoxels];
+    if (trim && std::none_of(values, values + kBlockVoxels, [&](float v) { return std::abs(v) < band; }))
+      continue;
+    auto* leaf = new FloatGrid::TreeType::LeafNodeType(openvdb::Coord(o.x(), o.y(), o.z()), 0.f, !trim);
+    float* out = leaf->buffer().data();
+    for (int i = 0; i < kBlockVoxels; ++i) {
+      out[i] = trim ? std::clamp(values[i], -band, band) : values[i];
+      if (trim && std::abs(values[i]) < band) leaf->setValueOn(openvdb::Index(i));
+    }
     tree.addLeaf(leaf);
   }
   openvdb::tools::signedFloodFill(tree);
   return grid;
 }
 
-// The raw sphere union's inside values are the depth under the nearest sphere's surface, not
-// under the union's, so they never reach -radius and fall to -0.27 voxels between particles. Keep the voxels
-// outside (exact distances) and the first inside layer (a 6-neighbour outside), and give every other inside
-// voxel the chamfer depth max_y (phi(y) - |x - y|) over its 26 neighbours, `passes` Jacobi passes
-// (each reaches a voxel or more deeper; 4 cover the 3-voxel band). Upper bounds on the depth along 26-neighbour
-// paths, at most 8% too deep on oblique paths, which the Eikonal iterations then fix; measured on the test
-// block, the band 1.5 spacings under the top face holds -1.47 spacings (-1.40 with the old 3 + 6 iterations).
-// Jacobi (read the previous pass, write this one): the same values at any thread count.
-void chamferInside(FloatGrid& grid, double voxel, int passes) {
-  using LeafT = FloatGrid::TreeType::LeafNodeType;
-  const float band = float(kHalfWidthVoxels * voxel);
-  const FloatGrid::Ptr raw = grid.deepCopy();
-  const auto deep = [&](const FloatGrid::ConstAccessor& a, const openvdb::Coord& c, float v) {
-    if (v >= 0) return false;
-    for (int k = 0; k < 3; ++k)
-      for (int s = -1; s <= 1; s += 2) {
-        openvdb::Coord n = c;
-        n[k] += s;
-        if (a.getValue(n) >= 0) return false;
-      }
-    return true;
-  };
-  float step[27];
-  for (int dx = -1; dx <= 1; ++dx)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dz = -1; dz <= 1; ++dz)
-        step[(dx + 1) * 9 + (dy + 1) * 3 + dz + 1] = float(voxel * std::sqrt(double(dx * dx + dy * dy + dz * dz)));
-  openvdb::tree::LeafManager<FloatGrid::TreeType> leaves(grid.tree());
-  leaves.foreach([&](LeafT& leaf, size_t) {
-    const auto a = raw->getConstAccessor();
-    for (auto it = leaf.beginValueOn(); it; ++it)
-      if (deep(a, it.getCoord(), *it)) it.setValue(-band);
-  });
-  for (int pass = 0; pass < passes; ++pass) {
-    const FloatGrid::Ptr prev = grid.deepCopy();
-    leaves.foreach([&](LeafT& leaf, size_t) {
-      const auto a = raw->getConstAccessor();
-      const auto b = prev->getConstAccessor();
-      for (auto it = leaf.beginValueOn(); it; ++it) {
-        const openvdb::Coord c = it.getCoord();
-        if (!deep(a, c, a.getValue(c))) continue;
-        float best = -band;
-        for (int dx = -1; dx <= 1; ++dx)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dz = -1; dz <= 1; ++dz) {
-              const float y = b.getValue(c.offsetBy(dx, dy, dz));
-              if (y < 0) best = std::max(best, y - step[(dx + 1) * 9 + (dy + 1) * 3 + dz + 1]);
-            }
-        it.setValue(best);
-      }
-    });
-  }
-}
-
-// OpenVDB's interrupter interface over Surge's Ctrl-C flag: a long frame stops inside OpenVDB's loops, and the
-// caller turns the flag into surge::Interrupted with Progress::checkInterrupt().
+// OpenVDB's interrupter interface over Surge's Ctrl-C flag: a long frame stops inside OpenVDB's loops, and
+// the caller turns the flag into surge::Interrupted with Progress::checkInterrupt().
 struct CtrlCInterrupter {
   void start(const char* = nullptr) {}
   void end() {}
@@ -202,9 +153,8 @@ struct CtrlCInterrupter {
 
 // The raw level set of a frame's particles, by method: distances right near the zero crossing, roughly
 // right (clamped to the band) elsewhere.
-FloatGrid::Ptr rawLevelSet(const ParticleFrame& frame, const Parameters& p) {
+BlockField rawLevelSet(const ParticleFrame& frame, const Parameters& p, double band) {
   const std::vector<Eigen::Vector3f> x = slabPositions(frame, p, frame.position, true);
-  const double band = kHalfWidthVoxels * p.voxel;
   FieldParticles particles;
   particles.position = &x;
   FieldParameters f;
@@ -232,7 +182,7 @@ FloatGrid::Ptr rawLevelSet(const ParticleFrame& frame, const Parameters& p) {
     throw RunError("surface: unknown surface.method \"" + p.method + "\"");
   }
   Progress::checkInterrupt();
-  return gridFromBlocks(rasterizeField(particles, f), p.voxel);
+  return rasterizeField(particles, f);
 }
 
 // How far to erode (positive) the smoothed level set of each method so that a flat face of a resting fluid
@@ -242,58 +192,55 @@ double erosionOf(const Parameters& p) {
   // the centres of its outer layer, while the sphere union reaches `radius` beyond them at the centres and
   // h/sqrt(2) (for radius = h) between them. Eroding by radius - h/2 would put the sphere tops on the
   // fluid's face; the smoothed surface lies kDentFill * h under the tops, so that much less is eroded and the
-  // faces land on the fluid's (a 20x10x10 block then encloses N h^3 less 1.1%, lost at its rounded edges;
-  // 0.6% before chamferInside made the raw inside a distance).
+  // faces land on the fluid's (a 20x10x10 block then encloses N h^3 less 1.75%, lost at its rounded edges).
   if (p.method == "spheres") return p.radius - 0.5 * p.spacing - kDentFill * p.spacing;
   if (p.method == "smooth_spheres") return p.radius - 0.5 * p.spacing - kZbInset * p.spacing;
   return -kAnisoInset * p.spacing;
 }
 
-// The level set of a frame: raw field, re-distancing, smoothing, erosion.
-FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
-  initOpenVdb();
-  const Parameters p = resolve(frame, scene);
-  FloatGrid::Ptr grid = emptyLevelSet(p.voxel);
-  if (frame.size() == 0) return grid;
-  // Spheres under 1.5 voxels are under-resolved: OpenVDB's own rasteriser skips them without a word, and the
-  // smoothing below would erase what is left. The scene loader forbids such voxels; a hand-made Scene may not
-  // have gone through it.
-  if (p.radius / p.voxel < 1.5)
-    throw RunError("surface: particle_radius " + std::to_string(p.radius) + " is under 1.5 voxels of " +
-                   std::to_string(p.voxel) + "; the particles' spheres would be lost");
-  CtrlCInterrupter interrupter;
-  grid = rawLevelSet(frame, p);
+// `spheres`, on NarrowBand: the raw union made a distance (Eikonal iterations across the working band: its
+// inside values are depths under the nearest sphere, not under the union, so never below -radius), smoothed,
+// made a distance again, eroded, made a distance to the eroded surface, trimmed to the band. The inside is
+// kept deeper than the band by the erosion and a voxel more, so that the eroded band is whole.
+FloatGrid::Ptr sphereLevelSet(const ParticleFrame& frame, const Parameters& p, int smoothingSteps) {
+  const double band = kHalfWidthVoxels * p.voxel, erosion = erosionOf(p);
+  const double inside = band + std::max(erosion, 0.0) + p.voxel;
+  NarrowBand field(rawLevelSet(frame, p, band), p.voxel, float(band), float(inside));
   Progress::checkInterrupt();
+  field.redistance(int(std::ceil(inside / p.voxel)));
+  for (int i = 0; i < smoothingSteps; ++i) field.meanCurvatureStep();
+  field.redistance(kRedistanceIterations);
+  field.offset(float(erosion));
+  field.redistance(kRedistanceIterations);
+  Progress::checkInterrupt();
+  return gridFromBlocks(field.blocks(), p.voxel, /*trim=*/true);
+}
 
-  // The raw distances are right outside the spheres but not inside them (a voxel holds the distance to the
-  // surface of its nearest sphere, not of the union), nor for the blended fields. LevelSetTracker's
-  // normalisation (Eikonal iterations in the band, kRenormalise of them) puts the band right from the zero
-  // crossing outward, and trims it back to the narrow band. For `spheres` the inside is made a distance first
-  // (chamferInside), so one iteration does. (tools::sdfToSdf, fast sweeping, did the same
-  // here first and took 90% of the time: 85 s for a million particles, against 1.5 s for this.)
-  const bool spheres = p.method == "spheres";
-  if (spheres) chamferInside(*grid, p.voxel, kChamferPasses);
+// The blended fields, with OpenVDB's level-set tools: raw field, re-distancing, smoothing, erosion (or, for
+// `anisotropic`, dilation). (Run on NarrowBand as `spheres` is, the anisotropic field's surface came out
+// bumpy and 0.27 spacings too deep, and smooth_spheres' block lost 4%: the voxels beside their zero crossing,
+// which NarrowBand::redistance keeps, need the re-distancing that moves them too.)
+FloatGrid::Ptr blendedLevelSet(const ParticleFrame& frame, const Parameters& p, int smoothingSteps) {
+  CtrlCInterrupter interrupter;
+  FloatGrid::Ptr grid =
+      gridFromBlocks(rawLevelSet(frame, p, kHalfWidthVoxels * p.voxel), p.voxel, /*trim=*/false);
   Progress::checkInterrupt();
+  // The blended fields are distances only near their zero crossing. LevelSetTracker's normalisation (Eikonal
+  // iterations in the band, kRenormalise of them) puts the band right from the zero crossing outward, and
+  // trims it back to the narrow band. (tools::sdfToSdf, fast sweeping, did the same here first and took 90%
+  // of the time: 85 s for a million particles, against 1.5 s for this.)
   openvdb::tools::LevelSetFilter<FloatGrid, FloatGrid, CtrlCInterrupter> filter(*grid, &interrupter);
-  filter.setNormCount(spheres ? kSpheresFirstIterations : kRenormalise);
+  filter.setNormCount(kRenormalise);
   filter.normalize();
   filter.prune();  // voxels now beyond the band become inactive background
   Progress::checkInterrupt();
-  // After each smoothing step one Eikonal iteration (LevelSetTracker's default): a step moves the surface by a
-  // fraction of a voxel, and a band that was a distance stays nearly one. 3 iterations a step (as before)
-  // cost 40% of a frame and changed the block's volume by 0.5% and the ball's radius by 0.03 voxels. The
-  // anisotropic field keeps 3: its dilation below moves the surface 1.5 voxels in CFL steps, and with one
-  // iteration a step the block lost 9% more.
+  // After each smoothing step one Eikonal iteration (LevelSetTracker's default): a step moves the surface by
+  // a fraction of a voxel, and a band that was a distance stays nearly one. The anisotropic field keeps 3:
+  // its dilation below moves the surface 1.5 voxels in CFL steps, and with one iteration a step the block
+  // lost 9% more.
   const bool anisotropic = p.method == "anisotropic";
   filter.setNormCount(anisotropic ? kRenormalise : 1);
-
-  // Smooth first, erode second: mean-curvature flow fills the dents between the spheres and rounds the sphere
-  // caps, the erosion then takes the surface back to the fluid. (Eroding first would leave a lone particle
-  // a sphere of one voxel, which smoothing then erases.)
-  // Mean-curvature flow steps (surface.smoothing_steps, default 2): enough to take out the bumps of the sphere
-  // union (on a flat face they go from 0.04 to 0.004 spacings rms in two steps; each step moves the surface by
-  // a third of a voxel times its curvature in voxels), few enough to keep edges and small droplets.
-  for (int i = 0; i < scene.surface.smoothing_steps; ++i) filter.meanCurvature();
+  for (int i = 0; i < smoothingSteps; ++i) filter.meanCurvature();
   // Positive offsets shrink the level set (phi + offset, phi < 0 inside).
   const double erosion = erosionOf(p);
   if (erosion > 0) {
@@ -302,16 +249,38 @@ FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
     // than LevelSetFilter::offset's CFL steps of half a voxel, each followed by a track.
     openvdb::tree::LeafManager<FloatGrid::TreeType> leaves(grid->tree());
     const float c = float(erosion);
-    leaves.foreach([c](FloatGrid::TreeType::LeafNodeType& leaf, size_t) {
+    leaves.foreach ([c](FloatGrid::TreeType::LeafNodeType& leaf, size_t) {
       for (auto it = leaf.beginValueOn(); it; ++it) it.setValue(*it + c);
     });
     const int tracks = int(std::ceil(erosion / p.voxel - 1e-9));
-    filter.setNormCount(spheres ? kSpheresErodeIterations : 2 * kRenormalise);
+    filter.setNormCount(2 * kRenormalise);
     for (int i = 0; i < tracks; ++i) filter.track();
   } else if (erosion < 0) {
     // Dilation (anisotropic): the outer band must grow as the surface moves out, which the CFL steps do.
     filter.offset(float(erosion));
   }
+  return grid;
+}
+
+// The level set of a frame. Smooth first, erode second: mean-curvature flow fills the dents between the
+// spheres and rounds the sphere caps, the erosion then takes the surface back to the fluid. (Eroding first
+// would leave a lone particle a sphere of one voxel, which smoothing then erases.) Mean-curvature flow steps
+// (surface.smoothing_steps, default 2): enough to take out the bumps of the sphere union (on a flat face they
+// go from 0.04 to 0.004 spacings rms in two steps; each step moves the surface by a third of a voxel times
+// its curvature in voxels), few enough to keep edges and small droplets.
+FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
+  initOpenVdb();
+  const Parameters p = resolve(frame, scene);
+  if (frame.size() == 0) return emptyLevelSet(p.voxel);
+  // Spheres under 1.5 voxels are under-resolved: OpenVDB's own rasteriser skips them without a word, and the
+  // smoothing would erase what is left. The scene loader forbids such voxels; a hand-made Scene may not
+  // have gone through it.
+  if (p.radius / p.voxel < 1.5)
+    throw RunError("surface: particle_radius " + std::to_string(p.radius) + " is under 1.5 voxels of " +
+                   std::to_string(p.voxel) + "; the particles' spheres would be lost");
+  const int steps = scene.surface.smoothing_steps;
+  FloatGrid::Ptr grid =
+      p.method == "spheres" ? sphereLevelSet(frame, p, steps) : blendedLevelSet(frame, p, steps);
   Progress::checkInterrupt();
   return grid;
 }
@@ -331,7 +300,8 @@ TriangleMesh meshLevelSet(const FloatGrid& grid, double adaptivity) {
   openvdb::tools::volumeToMesh(grid, points, triangles, quads, /*isovalue=*/0.0, adaptivity);
 
   mesh.positions.resize(points.size());
-  for (size_t i = 0; i < points.size(); ++i) mesh.positions[i] = Eigen::Vector3f(points[i].x(), points[i].y(), points[i].z());
+  for (size_t i = 0; i < points.size(); ++i)
+    mesh.positions[i] = Eigen::Vector3f(points[i].x(), points[i].y(), points[i].z());
   mesh.triangles.reserve(triangles.size() + 2 * quads.size());
   for (const auto& t : triangles) addTriangle(mesh, t[0], t[1], t[2]);
   // Quads are split along their shorter diagonal, which gives the better-shaped pair of triangles.
@@ -370,8 +340,8 @@ TriangleMesh meshLevelSet(const FloatGrid& grid, double adaptivity) {
   });
   std::vector<Eigen::Vector3f> faceSum;
   for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3f n = (mesh.positions[t[1]] - mesh.positions[t[0]])
-                                  .cross(mesh.positions[t[2]] - mesh.positions[t[0]]);
+    const Eigen::Vector3f n =
+        (mesh.positions[t[1]] - mesh.positions[t[0]]).cross(mesh.positions[t[2]] - mesh.positions[t[0]]);
     for (uint32_t v : t) {
       if (mesh.normals[v].squaredNorm() > 0) continue;
       if (faceSum.empty()) faceSum.assign(mesh.positions.size(), Eigen::Vector3f::Zero());
@@ -379,7 +349,8 @@ TriangleMesh meshLevelSet(const FloatGrid& grid, double adaptivity) {
     }
   }
   for (size_t i = 0; i < faceSum.size(); ++i)
-    if (mesh.normals[i].squaredNorm() == 0 && faceSum[i].squaredNorm() > 0) mesh.normals[i] = faceSum[i].normalized();
+    if (mesh.normals[i].squaredNorm() == 0 && faceSum[i].squaredNorm() > 0)
+      mesh.normals[i] = faceSum[i].normalized();
   return mesh;
 }
 
@@ -462,12 +433,14 @@ SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const 
 
 void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress) {
   const std::vector<int> all = listFrames(dir, "particles", "ply");
-  if (all.empty()) throw InputError(dir.string(), "no particle frames (particles/frame_NNNNN.ply) to surface");
+  if (all.empty())
+    throw InputError(dir.string(), "no particle frames (particles/frame_NNNNN.ply) to surface");
   std::vector<int> frames;
   std::copy_if(all.begin(), all.end(), std::back_inserter(frames), [&](int f) { return range.contains(f); });
   if (frames.empty())
-    throw InputError(dir.string(), "--frames", "no particle frame in " + std::to_string(range.first) + ":" +
-                                                  std::to_string(range.last));
+    throw InputError(
+        dir.string(), "--frames",
+        "no particle frame in " + std::to_string(range.first) + ":" + std::to_string(range.last));
   progress.start("surface", frames.size());
   // Frames in parallel, one chunk each (OpenVDB's and our own loops inside a frame share the same oneTBB
   // workers). Each frame's files depend only on its particles, so the bytes are the same at any thread count.
@@ -479,7 +452,8 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
           Progress::checkInterrupt();
           const int f = frames[i];
           const ParticleFrame frame = readParticlePly(framePath(dir, "particles", f, "ply"));
-          surfaceFrame(frame, scene, framePath(dir, "surface", f, "vdb"), framePath(dir, "surface", f, "ply"));
+          surfaceFrame(frame, scene, framePath(dir, "surface", f, "vdb"),
+                       framePath(dir, "surface", f, "ply"));
           const std::lock_guard<std::mutex> lock(advance);
           progress.advance();
         }

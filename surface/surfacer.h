@@ -7,9 +7,10 @@
 //     `anisotropic` (Yu & Turk 2013, anisotropy.h; iso-value half the rest field, dilated back to the fluid's
 //     faces by an inset measured on a block). Spheres under 1.5 voxels
 //     throw: the smoothing would erase them.
-//  2. Re-distance it (LevelSetTracker), smooth it by surface.smoothing_steps of mean-curvature flow and
-//     erode (or, for `anisotropic`, dilate) it back to the fluid's volume (tools::LevelSetFilter; spheres of radius ~ spacing make a block
-//     fatter than its N * spacing^3 of fluid).
+//  2. Make it a distance, smooth it by surface.smoothing_steps of mean-curvature flow, and erode (or, for
+//     `anisotropic`, dilate) it back to the fluid's volume (spheres of radius ~ spacing make a block fatter
+//     than its N * spacing^3 of fluid), re-distancing after each step. `spheres` does this on narrow_band.h's
+//     blocks; the blended fields with OpenVDB's LevelSetTracker and LevelSetFilter.
 //  3. Mesh the zero crossing (tools::volumeToMesh), split quads into triangles, orient them outward and give
 //     each vertex the normalised level-set gradient as its normal.
 // 2D frames (z = 0) are extruded into a closed slab a few particles thick (see surfacer.cpp).
@@ -31,15 +32,16 @@ struct SurfaceStats {
 
 // Level set of one particle frame -> mesh. Writes vdbPath (a level-set grid named "surface"; with
 // surface.write_velocity a vector grid "v", with surface.write_points a PointDataGrid "points" with attribute
-// "v") and meshPath (binary PLY with vertex normals; with surface.write_obj also an .obj beside it), each atomically (temporary name in the same folder, then rename).
-// Throws RunError if OpenVDB would drop a particle (sphere under 1.5 voxels), Interrupted on Ctrl-C.
+// "v") and meshPath (binary PLY with vertex normals; with surface.write_obj also an .obj beside it), each
+// atomically (temporary name in the same folder, then rename). Throws RunError if OpenVDB would drop a
+// particle (sphere under 1.5 voxels), Interrupted on Ctrl-C.
 SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const fs::path& vdbPath,
                           const fs::path& meshPath);
 
 // The stage: for every dir/particles/frame_NNNNN.ply within range, writes dir/surface/frame_NNNNN.vdb and
-// dir/surface/frame_NNNNN.ply, frames in parallel (parallelFor, one frame a chunk: the same bytes at any thread
-// count). Reports progress per frame ("surface") and checks for Ctrl-C between frames.
-// Throws InputError naming dir if there is no particle frame (in range).
+// dir/surface/frame_NNNNN.ply, frames in parallel (parallelFor, one frame a chunk: the same bytes at any
+// thread count). Reports progress per frame ("surface") and checks for Ctrl-C between frames. Throws
+// InputError naming dir if there is no particle frame (in range).
 void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress);
 
 // For tests: the mesh of a frame, with no file written.

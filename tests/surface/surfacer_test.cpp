@@ -7,13 +7,13 @@
 #include "surface/surfacer.h"
 
 #include <gtest/gtest.h>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <map>
-#include <openvdb/io/File.h>
-#include <openvdb/openvdb.h>
 #include <utility>
 
 #include "core/errors.h"
@@ -29,8 +29,8 @@ Scene sceneWithSpacing(double h, int dimensions = 3, const char* method = "spher
   scene.name = "surfacer_test";
   scene.dimensions = dimensions;
   scene.particle_spacing = h;
-  scene.surface.particle_radius = h;     // the loader's default
-  scene.surface.voxel_size = h / 2;      // the loader's default
+  scene.surface.particle_radius = h;  // the loader's default
+  scene.surface.voxel_size = h / 2;   // the loader's default
   scene.surface.adaptivity = 0;
   return scene;
 }
@@ -98,8 +98,8 @@ void expectUnitNormals(const TriangleMesh& mesh) {
 
 fs::path uniqueTempDir() {
   const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::path(testing::TempDir()) /
-                       ("surge_surface_" + std::to_string(::getpid()) + "_" + info->name());
+  const fs::path dir =
+      fs::path(testing::TempDir()) / ("surge_surface_" + std::to_string(::getpid()) + "_" + info->name());
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -126,9 +126,11 @@ void expectBallOfTheFluidsVolume(const char* method) {
     hi = std::max(hi, r);
   }
   const double mean = sum / double(mesh.positions.size());
-  testing::Test::RecordProperty(std::string("mean_radius_error_voxels_") + method, std::to_string((mean - expected) / voxel));
-  std::printf("ball (%s): N=%zu expected radius %.5f, mesh mean %.5f (error %.3f voxels), min %.5f max %.5f\n",
-              method, frame.size(), expected, mean, (mean - expected) / voxel, lo, hi);
+  testing::Test::RecordProperty(std::string("mean_radius_error_voxels_") + method,
+                                std::to_string((mean - expected) / voxel));
+  std::printf(
+      "ball (%s): N=%zu expected radius %.5f, mesh mean %.5f (error %.3f voxels), min %.5f max %.5f\n",
+      method, frame.size(), expected, mean, (mean - expected) / voxel, lo, hi);
   // One voxel: the erosion is calibrated on flat lattice faces, whereas the ball's surface is a staircase of
   // lattice layers whose steps are a spacing (two voxels) high. Measured: +0.27 voxels (spheres),
   // +0.20 (smooth_spheres), -0.14 (anisotropic).
@@ -154,7 +156,9 @@ void expectBallOfTheFluidsVolume(const char* method) {
   EXPECT_NEAR(signedDistanceAt(frame, scene, centre + Eigen::Vector3d(0, 1, 0)), 3 * voxel, 1e-6);
 }
 
-TEST(Surfacer, BallOfParticlesGivesASphereOfTheFluidsVolume) { expectBallOfTheFluidsVolume("spheres"); }
+TEST(Surfacer, BallOfParticlesGivesASphereOfTheFluidsVolume) {
+  expectBallOfTheFluidsVolume("spheres");
+}
 
 TEST(Surfacer, RestingBlockEnclosesItsFluidVolumeAndIsClosed) {
   const double h = 0.02;
@@ -163,15 +167,42 @@ TEST(Surfacer, RestingBlockEnclosesItsFluidVolumeAndIsClosed) {
   const TriangleMesh mesh = meshParticles(frame, scene);
   const double fluid = double(frame.size()) * h * h * h;
   const double volume = signedVolume(mesh);
-  std::printf("block: N=%zu fluid volume %.6g, mesh volume %.6g (error %.2f%%), %zu triangles\n", frame.size(),
-              fluid, volume, 100 * (volume / fluid - 1), mesh.triangles.size());
+  std::printf("block: N=%zu fluid volume %.6g, mesh volume %.6g (error %.2f%%), %zu triangles\n",
+              frame.size(), fluid, volume, 100 * (volume / fluid - 1), mesh.triangles.size());
   // 3%: for this 20x10x10 block the area is 1000 h^2 against 2000 h^3 of volume, so 3% is a face 0.06 h
   // (an eighth of a voxel) off on average, or the 160 h of edges rounded to a radius of about 1.3 h
-  // ((1 - pi/4) r^2 lost per unit length). Measured: -1.1% (-0.6% before chamferInside), the faces within
-  // 0.01 h, the loss at the edges.
+  // ((1 - pi/4) r^2 lost per unit length). Measured: -1.75%, the faces within 0.001 h (the next test), the
+  // loss at the edges.
   EXPECT_NEAR(volume / fluid, 1.0, 0.03);
   expectClosedAndOriented(mesh);
   expectUnitNormals(mesh);
+}
+
+TEST(Surfacer, BandAcrossABlocksFaceIsASignedDistanceToTheFluidsFace) {
+  // Down columns through the top face of the block (16 of them, away from the edges), the level set at 1, 0.5
+  // spacings above the fluid's face, on it, and 0.5, 1, 1.5 below: the distance to that face. Tolerance 0.05
+  // spacings (a tenth of a voxel): each method's face is calibrated onto the fluid's (kDentFill, kZbInset,
+  // kAnisoInset; measured 0.0002, 0.014 and 0.002 spacings off), and for `spheres` the voxels beside the
+  // surface keep the smoothed field's own values, whose slope across a lattice's face is about 0.93, so
+  // 0.035 spacings short a voxel out, which the Eikonal iterations carry on at slope 1. Measured worst:
+  // 0.038 (spheres, 1 spacing out), 0.032 (smooth_spheres, 1.5 in).
+  const double h = 0.02;
+  const ParticleFrame frame = block(20, 10, 10, h, Eigen::Vector3d(0.11, 0.01, 0.01));
+  const double top = 0.01 + 9.5 * h;
+  for (const char* method : {"spheres", "smooth_spheres", "anisotropic"}) {
+    const Scene scene = sceneWithSpacing(h, 3, method);
+    for (double height : {1.0, 0.5, 0.0, -0.5, -1.0, -1.5}) {
+      double sum = 0;
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) {
+          const Eigen::Vector3d x(0.11 + 6 * h + a * 0.74 * h, top + height * h, 0.01 + 3 * h + b * 0.37 * h);
+          sum += signedDistanceAt(frame, scene, x);
+        }
+      std::printf("%s, top face: phi %.4f spacings at %.1f spacings above it\n", method, sum / 16 / h,
+                  height);
+      EXPECT_NEAR(sum / 16 / h, height, 0.05) << method << " at " << height << " spacings above the face";
+    }
+  }
 }
 
 TEST(Surfacer, AdaptiveMeshIsCoarserAndStillClosed) {
@@ -183,7 +214,8 @@ TEST(Surfacer, AdaptiveMeshIsCoarserAndStillClosed) {
   const TriangleMesh adaptive = meshParticles(frame, scene);
   EXPECT_LT(adaptive.triangles.size(), uniform.triangles.size());
   expectClosedAndOriented(adaptive);
-  // Merging flat cells moves vertices by a fraction of a voxel on the rounded edges only: 3% as for the block.
+  // Merging flat cells moves vertices by a fraction of a voxel on the rounded edges only: 3% as for the
+  // block.
   EXPECT_NEAR(signedVolume(adaptive) / signedVolume(uniform), 1.0, 0.03);
 }
 
@@ -230,10 +262,10 @@ TEST(Surfacer, OneParticleGivesASmallClosedMesh) {
   ASSERT_GE(mesh.triangles.size(), 4u);
   expectClosedAndOriented(mesh);
   expectUnitNormals(mesh);
-  // A speck, not a droplet of the particle's volume: the sphere of radius h is 2 voxels, and the mean-curvature
-  // smoothing that flattens the bumps of a fluid's faces shrinks so small a sphere fast (its speed is the
-  // curvature), before the erosion takes the rest. Measured over 200 random positions: 0.6% to 4% of h^3.
-  // Asserted: positive, under h^3, and inside the particle's sphere.
+  // A speck, not a droplet of the particle's volume: the sphere of radius h is 2 voxels, and the
+  // mean-curvature smoothing that flattens the bumps of a fluid's faces shrinks so small a sphere fast (its
+  // speed is the curvature), before the erosion takes the rest. Measured over 200 random positions: 0.6% to
+  // 4% of h^3. Asserted: positive, under h^3, and inside the particle's sphere.
   const double volume = signedVolume(mesh);
   EXPECT_GT(volume, 0);
   EXPECT_LT(volume, h * h * h);
@@ -271,7 +303,8 @@ TEST(Surfacer, TwoDimensionalFrameGivesAClosedSlab) {
   // The slab holds 7 layers (z = -3h .. 3h): its volume is about 7 N h^3; 5% allows for the rounding of the
   // slab's edges, which are a larger share of its volume than of the block's.
   const double volume = signedVolume(mesh);
-  std::printf("slab: N=%zu volume / (7 N h^3) = %.4f\n", frame.size(), volume / (7 * double(frame.size()) * h * h * h));
+  std::printf("slab: N=%zu volume / (7 N h^3) = %.4f\n", frame.size(),
+              volume / (7 * double(frame.size()) * h * h * h));
   EXPECT_NEAR(volume / (7 * double(frame.size()) * h * h * h), 1.0, 0.05);
   float zmin = 1, zmax = -1;
   for (const auto& x : mesh.positions) zmin = std::min(zmin, x.z()), zmax = std::max(zmax, x.z());
@@ -391,7 +424,7 @@ TEST(SurfacerMethods, AnisotropicKernelsLeaveAFlatSurfaceFlatterThanSpheres) {
     std::printf("%s: normal variance on the top face %.3g\n", methods[m], variance[m]);
   }
   // Strictly lower: the claim of YT13 is qualitative, so the test asserts only the order, at the same voxel
-  // size and smoothing. Measured: 0.0044 (spheres), 0.0033 (anisotropic).
+  // size and smoothing. Measured: 0.0045 (spheres), 0.0033 (anisotropic).
   EXPECT_LT(variance[1], variance[0]);
 }
 
@@ -428,8 +461,10 @@ TEST(SurfacerVdb, RoundTripsNameClassVoxelAndTransformWithVelocityAndPoints) {
   ASSERT_TRUE(vgrid);
   size_t moving = 0, other = 0;
   for (auto it = vgrid->cbeginValueOn(); it; ++it) {
-    if ((*it - openvdb::Vec3s(1.0f, -2.0f, 0.5f)).length() < 1e-5f) ++moving;
-    else if ((*it).length() != 0) ++other;
+    if ((*it - openvdb::Vec3s(1.0f, -2.0f, 0.5f)).length() < 1e-5f)
+      ++moving;
+    else if ((*it).length() != 0)
+      ++other;
   }
   EXPECT_GT(moving, 0u);
   EXPECT_EQ(other, 0u);
