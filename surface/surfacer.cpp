@@ -467,10 +467,15 @@ TriangleMesh meshParticles(const ParticleFrame& frame, const Scene& scene) {
   return meshLevelSet(*grid, scene.surface.adaptivity);
 }
 
-double signedDistanceAt(const ParticleFrame& frame, const Scene& scene, const Eigen::Vector3d& point) {
+std::vector<double> signedDistancesAt(const ParticleFrame& frame, const Scene& scene,
+                                      const std::vector<Eigen::Vector3d>& points) {
   const FloatGrid::Ptr grid = buildLevelSet(frame, scene);
-  const openvdb::Vec3d ijk = grid->transform().worldToIndex(openvdb::Vec3d(point.x(), point.y(), point.z()));
-  return double(openvdb::tools::BoxSampler::sample(grid->getConstAccessor(), ijk));
+  std::vector<double> distances;
+  for (const Eigen::Vector3d& x : points) {
+    const openvdb::Vec3d ijk = grid->transform().worldToIndex(openvdb::Vec3d(x.x(), x.y(), x.z()));
+    distances.push_back(double(openvdb::tools::BoxSampler::sample(grid->getConstAccessor(), ijk)));
+  }
+  return distances;
 }
 
 }  // namespace surge

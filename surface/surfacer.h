@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include "core/files.h"
 #include "core/ply.h"
@@ -47,8 +48,9 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
 // For tests: the mesh of a frame, with no file written.
 TriangleMesh meshParticles(const ParticleFrame& frame, const Scene& scene);
 
-// For tests: the signed distance (world units, negative inside) at a world point of the level set that
-// surfaceFrame builds for this frame; the background value (+3 voxels) far from the surface.
-double signedDistanceAt(const ParticleFrame& frame, const Scene& scene, const Eigen::Vector3d& point);
+// For tests: the signed distances (world units, negative inside, trilinear) at world points of the level set
+// that surfaceFrame builds for this frame; the background value (+3 voxels) far from the surface.
+std::vector<double> signedDistancesAt(const ParticleFrame& frame, const Scene& scene,
+                                      const std::vector<Eigen::Vector3d>& points);
 
 }  // namespace surge

@@ -151,9 +151,11 @@ void expectBallOfTheFluidsVolume(const char* method) {
   // The level set itself: zero on the sphere (within the voxel of the mesh), negative inside, the narrow
   // band's background (+3 voxels) far outside.
   const Eigen::Vector3d onSurface = centre + Eigen::Vector3d(expected, 0, 0);
-  EXPECT_NEAR(signedDistanceAt(frame, scene, onSurface), 0.0, voxel);
-  EXPECT_LT(signedDistanceAt(frame, scene, centre), 0.0);
-  EXPECT_NEAR(signedDistanceAt(frame, scene, centre + Eigen::Vector3d(0, 1, 0)), 3 * voxel, 1e-6);
+  const std::vector<double> phi =
+      signedDistancesAt(frame, scene, {onSurface, centre, centre + Eigen::Vector3d(0, 1, 0)});
+  EXPECT_NEAR(phi[0], 0.0, voxel);
+  EXPECT_LT(phi[1], 0.0);
+  EXPECT_NEAR(phi[2], 3 * voxel, 1e-6);
 }
 
 TEST(Surfacer, BallOfParticlesGivesASphereOfTheFluidsVolume) {
@@ -190,14 +192,17 @@ TEST(Surfacer, BandAcrossABlocksFaceIsASignedDistanceToTheFluidsFace) {
   const ParticleFrame frame = block(20, 10, 10, h, Eigen::Vector3d(0.11, 0.01, 0.01));
   const double top = 0.01 + 9.5 * h;
   for (const char* method : {"spheres", "smooth_spheres", "anisotropic"}) {
-    const Scene scene = sceneWithSpacing(h, 3, method);
-    for (double height : {1.0, 0.5, 0.0, -0.5, -1.0, -1.5}) {
-      double sum = 0;
+    const std::vector<double> heights = {1.0, 0.5, 0.0, -0.5, -1.0, -1.5};
+    std::vector<Eigen::Vector3d> points;
+    for (double height : heights)
       for (int a = 0; a < 4; ++a)
-        for (int b = 0; b < 4; ++b) {
-          const Eigen::Vector3d x(0.11 + 6 * h + a * 0.74 * h, top + height * h, 0.01 + 3 * h + b * 0.37 * h);
-          sum += signedDistanceAt(frame, scene, x);
-        }
+        for (int b = 0; b < 4; ++b)
+          points.emplace_back(0.11 + 6 * h + a * 0.74 * h, top + height * h, 0.01 + 3 * h + b * 0.37 * h);
+    const std::vector<double> phi = signedDistancesAt(frame, sceneWithSpacing(h, 3, method), points);
+    for (size_t k = 0; k < heights.size(); ++k) {
+      const double height = heights[k];
+      double sum = 0;
+      for (size_t j = 0; j < 16; ++j) sum += phi[16 * k + j];
       std::printf("%s, top face: phi %.4f spacings at %.1f spacings above it\n", method, sum / 16 / h,
                   height);
       EXPECT_NEAR(sum / 16 / h, height, 0.05) << method << " at " << height << " spacings above the face";
