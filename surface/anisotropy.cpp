@@ -21,6 +21,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
+#include <vector>
 
 #include "core/parallel.h"
 
@@ -70,6 +72,7 @@ struct CellGrid {
   double cell = 0;
   Eigen::Vector3i dims;
   std::vector<uint32_t> start, order;
+  std::vector<Eigen::Vector3f> sorted;  // x[order[k]]: a cell's particles lie together in memory
 
   CellGrid(const std::vector<Eigen::Vector3f>& x, double radius) {
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
@@ -93,6 +96,8 @@ struct CellGrid {
     order.resize(x.size());
     std::vector<uint32_t> fill(start.begin(), start.end() - 1);
     for (size_t i = 0; i < x.size(); ++i) order[fill[key[i]]++] = uint32_t(i);  // stable: index order per cell
+    sorted.resize(x.size());
+    for (size_t k = 0; k < x.size(); ++k) sorted[k] = x[order[k]];
   }
   Eigen::Vector3i cellOf(const Eigen::Vector3f& p) const {
     Eigen::Vector3i c;
@@ -108,7 +113,7 @@ struct CellGrid {
       for (int y = std::max(c.y() - 1, 0); y <= std::min(c.y() + 1, dims.y() - 1); ++y)
         for (int x = std::max(c.x() - 1, 0); x <= std::min(c.x() + 1, dims.x() - 1); ++x) {
           const size_t cellIndex = index(Eigen::Vector3i(x, y, z));
-          for (uint32_t k = start[cellIndex]; k < start[cellIndex + 1]; ++k) f(order[k]);
+          for (uint32_t k = start[cellIndex]; k < start[cellIndex + 1]; ++k) f(order[k], sorted[k]);
         }
   }
 };
@@ -126,17 +131,26 @@ AnisotropicKernels anisotropicKernels(const std::vector<Eigen::Vector3f>& x, con
   const CellGrid grid(x, r);
   std::vector<float> extent(n);
 
+  const double r2 = r * r;
+  // Particles in the grid's cell order, so that neighbouring particles' neighbours are still in cache; each
+  // particle's result depends only on its neighbours, not on the order.
   parallelFor(0, n, [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) {
+    std::vector<std::pair<uint32_t, double>> within;  // the neighbours j with their weights w_ij
+    for (size_t k = begin; k < end; ++k) {
+      const size_t i = grid.order[k];
       const Eigen::Vector3d xi = x[i].cast<double>();
       // Step 2: the weighted mean, then the covariance about it (two passes, for accuracy in float data).
       double sumW = 0;
       int neighbours = 0;
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      grid.forNeighbours(x[i], [&](uint32_t j) {
-        const Eigen::Vector3d xj = x[j].cast<double>();
-        const double w = weight((xj - xi).norm(), r);
+      within.clear();
+      grid.forNeighbours(x[i], [&](uint32_t j, const Eigen::Vector3f& xjf) {
+        const Eigen::Vector3d xj = xjf.cast<double>();
+        const double d2 = (xj - xi).squaredNorm();
+        if (d2 >= r2) return;
+        const double w = weight(std::sqrt(d2), r);
         if (w <= 0) return;
+        within.emplace_back(j, w);
         sumW += w;
         mean += w * xj;
         neighbours += j != i;
@@ -149,13 +163,10 @@ AnisotropicKernels anisotropicKernels(const std::vector<Eigen::Vector3f>& x, con
         G = Eigen::Matrix3d::Identity() / (p.kn * h);  // isolated: a small sphere (Sigma~ = k_n I)
       } else {
         Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
-        grid.forNeighbours(x[i], [&](uint32_t j) {
-          const Eigen::Vector3d xj = x[j].cast<double>();
-          const double w = weight((xj - xi).norm(), r);
-          if (w <= 0) return;
-          const Eigen::Vector3d d = xj - mean;
+        for (const auto& [j, w] : within) {
+          const Eigen::Vector3d d = x[j].cast<double>() - mean;
           C += w * d * d.transpose();
-        });
+        }
         C /= sumW;
         // Step 3: eigen-decomposition of the symmetric C (ascending eigenvalues), the small axes clamped.
         const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(C);

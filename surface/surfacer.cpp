@@ -62,7 +62,8 @@ void initOpenVdb() {
 
 // Smooth spheres (ZB05): weights' support R = 2 spacings (the simulator's kernel radius), sphere radius r as
 // for `spheres`. The blend x-bar lies under the outer layer of a flat face, by kZbInset spacings (measured on
-// the test block), so the erosion for this method is r - 0.5 h - kZbInset h.
+// the test block: 0, the faces then land within 0.0003 spacings of the fluid's), so the erosion for this
+// method is r - 0.5 h - kZbInset h.
 constexpr double kZbSupport = 2.0;
 constexpr double kZbInset = 0.0;
 // Anisotropic (YT13): kernel support h = 2 spacings, PCA radius 3 spacings (YT13 take 2h; 3 spacings already
@@ -198,67 +199,67 @@ double erosionOf(const Parameters& p) {
   return -kAnisoInset * p.spacing;
 }
 
-// `spheres`, on NarrowBand: the raw union made a distance (Eikonal iterations across the working band: its
-// inside values are depths under the nearest sphere, not under the union, so never below -radius), smoothed,
-// made a distance again, eroded, made a distance to the eroded surface, trimmed to the band. The inside is
-// kept deeper than the band by the erosion and a voxel more, so that the eroded band is whole.
-FloatGrid::Ptr sphereLevelSet(const ParticleFrame& frame, const Parameters& p, int smoothingSteps) {
-  const double band = kHalfWidthVoxels * p.voxel, erosion = erosionOf(p);
-  const double inside = band + std::max(erosion, 0.0) + p.voxel;
-  NarrowBand field(rawLevelSet(frame, p, band), p.voxel, float(band), float(inside));
-  Progress::checkInterrupt();
-  field.redistance(int(std::ceil(inside / p.voxel)));
+// The steps after the field is a distance, on NarrowBand: smoothing, erosion, each followed by Eikonal
+// iterations, then trimmed to the band. The field's inside reaches deeper than the band by the erosion and a
+// voxel more, so that the eroded band is whole.
+FloatGrid::Ptr smoothAndErode(NarrowBand& field, const Parameters& p, int smoothingSteps) {
   for (int i = 0; i < smoothingSteps; ++i) field.meanCurvatureStep();
   field.redistance(kRedistanceIterations);
-  field.offset(float(erosion));
+  field.offset(float(erosionOf(p)));
   field.redistance(kRedistanceIterations);
   Progress::checkInterrupt();
   return gridFromBlocks(field.blocks(), p.voxel, /*trim=*/true);
 }
 
-// The blended fields, with OpenVDB's level-set tools: raw field, re-distancing, smoothing, erosion (or, for
-// `anisotropic`, dilation). (Run on NarrowBand as `spheres` is, the anisotropic field's surface came out
-// bumpy and 0.27 spacings too deep, and smooth_spheres' block lost 4%: the voxels beside their zero crossing,
-// which NarrowBand::redistance keeps, need the re-distancing that moves them too.)
+double insideDepth(const Parameters& p) {
+  return kHalfWidthVoxels * p.voxel + std::max(erosionOf(p), 0.0) + p.voxel;
+}
+
+// `spheres`: the raw union made a distance by Eikonal iterations across the whole working band (its inside
+// values are depths under the nearest sphere, not under the union, so never below -radius; the voxels beside
+// the zero crossing are exact distances to the union and are kept), then smoothAndErode.
+FloatGrid::Ptr sphereLevelSet(const ParticleFrame& frame, const Parameters& p, int smoothingSteps) {
+  const double band = kHalfWidthVoxels * p.voxel, inside = insideDepth(p);
+  NarrowBand field(rawLevelSet(frame, p, band), p.voxel, float(band), float(inside));
+  Progress::checkInterrupt();
+  field.redistance(int(std::ceil(inside / p.voxel)));
+  return smoothAndErode(field, p, smoothingSteps);
+}
+
+// The blended fields are distances only near their zero crossing, and the voxels beside it need moving too,
+// which NarrowBand::redistance does not do (it keeps them): run on NarrowBand from the raw field,
+// smooth_spheres' block lost 4% and the anisotropic surface came out bumpy. So OpenVDB's LevelSetTracker
+// re-distances them first (kRenormalise Eikonal iterations, HJWENO5, every voxel of the band moving), then
+// smooth_spheres goes on with smoothAndErode. `anisotropic` stays with tools::LevelSetFilter for its
+// smoothing and dilation: run through smoothAndErode its top face's normal variance went from 0.0033 to 0.013
+// (the CFL steps of LevelSetFilter::offset, each re-distanced, smooth it as they dilate it).
+// (tools::sdfToSdf, fast sweeping, did the first re-distancing here once and took 85 s for a million
+// particles.)
 FloatGrid::Ptr blendedLevelSet(const ParticleFrame& frame, const Parameters& p, int smoothingSteps) {
   CtrlCInterrupter interrupter;
   FloatGrid::Ptr grid =
       gridFromBlocks(rawLevelSet(frame, p, kHalfWidthVoxels * p.voxel), p.voxel, /*trim=*/false);
   Progress::checkInterrupt();
-  // The blended fields are distances only near their zero crossing. LevelSetTracker's normalisation (Eikonal
-  // iterations in the band, kRenormalise of them) puts the band right from the zero crossing outward, and
-  // trims it back to the narrow band. (tools::sdfToSdf, fast sweeping, did the same here first and took 90%
-  // of the time: 85 s for a million particles, against 1.5 s for this.)
   openvdb::tools::LevelSetFilter<FloatGrid, FloatGrid, CtrlCInterrupter> filter(*grid, &interrupter);
   filter.setNormCount(kRenormalise);
   filter.normalize();
   filter.prune();  // voxels now beyond the band become inactive background
   Progress::checkInterrupt();
-  // After each smoothing step one Eikonal iteration (LevelSetTracker's default): a step moves the surface by
-  // a fraction of a voxel, and a band that was a distance stays nearly one. The anisotropic field keeps 3:
-  // its dilation below moves the surface 1.5 voxels in CFL steps, and with one iteration a step the block
-  // lost 9% more.
-  const bool anisotropic = p.method == "anisotropic";
-  filter.setNormCount(anisotropic ? kRenormalise : 1);
-  for (int i = 0; i < smoothingSteps; ++i) filter.meanCurvature();
-  // Positive offsets shrink the level set (phi + offset, phi < 0 inside).
-  const double erosion = erosionOf(p);
-  if (erosion > 0) {
-    // Eroding a signed distance is adding a constant to it, exactly: one pass over the band, then one track
-    // (dilate the band a voxel on the inside, re-distance, trim the outside) per voxel of erosion, rather
-    // than LevelSetFilter::offset's CFL steps of half a voxel, each followed by a track.
-    openvdb::tree::LeafManager<FloatGrid::TreeType> leaves(grid->tree());
-    const float c = float(erosion);
-    leaves.foreach ([c](FloatGrid::TreeType::LeafNodeType& leaf, size_t) {
-      for (auto it = leaf.beginValueOn(); it; ++it) it.setValue(*it + c);
-    });
-    const int tracks = int(std::ceil(erosion / p.voxel - 1e-9));
-    filter.setNormCount(2 * kRenormalise);
-    for (int i = 0; i < tracks; ++i) filter.track();
-  } else if (erosion < 0) {
-    // Dilation (anisotropic): the outer band must grow as the surface moves out, which the CFL steps do.
-    filter.offset(float(erosion));
+  if (p.method == "smooth_spheres") {
+    BlockField blocks;
+    for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
+      const openvdb::Coord o = leaf->origin();
+      blocks.origins.emplace_back(o.x(), o.y(), o.z());
+      blocks.values.insert(blocks.values.end(), leaf->buffer().data(), leaf->buffer().data() + kBlockVoxels);
+    }
+    NarrowBand field(std::move(blocks), p.voxel, float(kHalfWidthVoxels * p.voxel), float(insideDepth(p)));
+    return smoothAndErode(field, p, smoothingSteps);
   }
+  // Anisotropic: 3 Eikonal iterations after each smoothing step (with one, the dilation below lost the block
+  // 9% more), then the dilation in CFL steps, which grow the outer band as the surface moves out.
+  filter.setNormCount(kRenormalise);
+  for (int i = 0; i < smoothingSteps; ++i) filter.meanCurvature();
+  filter.offset(float(erosionOf(p)));
   return grid;
 }
 
