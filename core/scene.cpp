@@ -374,6 +374,11 @@ void validate(Scene& s, const std::string& where) {
   if (surface.voxel_size > surface.particle_radius / 1.5)
     throw InputError(where, "surface.voxel_size",
                      "above particle_radius / 1.5: OpenVDB would drop every particle sphere");
+  // The surfacer keys its blocks of 8^3 voxels by 21-bit coordinates about the origin (2^23 voxels each way);
+  // half that leaves room for the band around the domain.
+  for (int k = 0; k < d; ++k)
+    if (std::max(std::abs(s.domain.min[k]), std::abs(s.domain.max[k])) / surface.voxel_size > double(1 << 22))
+      throw InputError(where, "surface.voxel_size", "the domain reaches more than 2^22 voxels from the origin");
 
   CameraSettings& camera = s.render.camera;
   if (camera.position == camera.look_at) {

@@ -96,6 +96,8 @@ TEST(Scene, EveryBadInputIsOneLineNamingFileAndKey) {
   EXPECT_NE(errorFor("/solver/method", "sph").find("solver.method: 'sph' is not one of"), std::string::npos);
   EXPECT_NE(errorFor("/domain/max", {1, 0, 0.5}).find("domain: min must be below max"), std::string::npos);
   EXPECT_NE(errorFor("/solver/kernel_radius", 0.04).find("solver.kernel_radius: must exceed"), std::string::npos);
+  EXPECT_NE(errorFor("/surface/voxel_size", 1e-8).find("surface.voxel_size: the domain reaches more than 2^22"),
+            std::string::npos);
 }
 
 TEST(Scene, InvalidJsonNamesTheByte) {
