@@ -55,6 +55,13 @@ std::vector<int> listFrames(const fs::path& dir, const std::string& sub, const s
   return frames;
 }
 
+void removeOrphanFrames(const fs::path& dir, const std::string& sub, const std::vector<std::string>& exts,
+                        const std::vector<int>& sources) {
+  for (const std::string& ext : exts)
+    for (int frame : listFrames(dir, sub, ext))
+      if (!std::binary_search(sources.begin(), sources.end(), frame)) fs::remove(framePath(dir, sub, frame, ext));
+}
+
 FrameRange FrameRange::parse(const std::string& text) {
   FrameRange range;
   const auto colon = text.find(':');

@@ -86,6 +86,17 @@ TEST(EndToEnd, RunMakesEveryStagesFiles) {
     stbi_image_free(pixels);
   }
   EXPECT_EQ(countVideoFrames(out / "tiny.mp4"), 4);
+
+  // A shorter run into the same folder: no stage keeps the earlier run's later frames, nor the video them.
+  const SurgeResult shorter =
+      runSurge("run '" + scene.string() + "' --set output.frames=1 --out '" + out.string() + "' --quiet");
+  ASSERT_EQ(shorter.status, 0) << shorter.err;
+  const std::vector<int> two = {0, 1};
+  EXPECT_EQ(listFrames(out, "particles", "ply"), two);
+  EXPECT_EQ(listFrames(out, "surface", "ply"), two);
+  EXPECT_EQ(listFrames(out, "surface", "vdb"), two);
+  EXPECT_EQ(listFrames(out, "frames", "png"), two);
+  EXPECT_EQ(countVideoFrames(out / "tiny.mp4"), 2);
 }
 
 TEST(EndToEnd, BadSceneIsOneLineExitTwoAndWritesNothing) {
