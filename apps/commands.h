@@ -39,11 +39,14 @@ void addKeysCommand(CLI::App& app);
 void addStudyCommand(CLI::App& app);
 
 // The stages, shared by their own subcommands and by `surge run`.
+// With `resume` (surge sim --resume, surge run --resume) each stage picks up where a stopped run left off: the
+// simulation from its last complete frame, the surface and render stages skipping the frames already up to date.
 void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const CommonOptions& options);
-void runSurfaceStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options);
+void runSurfaceStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options,
+                     bool resume = false);
 // renderer: "embree", "gl", or empty for the default of the scene's dimension.
 void runRenderStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options,
-                    const std::string& renderer = "");
+                    const std::string& renderer = "", bool resume = false);
 void runVideoStage(const Scene& scene, const fs::path& dir, const CommonOptions& options);
 
 }  // namespace surge

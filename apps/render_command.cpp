@@ -24,9 +24,10 @@ void renderStage(const Scene& scene, const fs::path& dir, const FrameRange& rang
 }  // namespace
 
 void runRenderStage(const Scene& scene, const fs::path& dir, const FrameRange& range,
-                    const CommonOptions& options, const std::string& renderer) {
+                    const CommonOptions& options, const std::string& renderer, bool resume) {
   RenderOptions renderOptions;
   renderOptions.renderer = renderer;
+  renderOptions.resume = resume;
   renderStage(scene, dir, range, options, renderOptions);
 }
 

@@ -10,7 +10,11 @@ namespace surge {
 
 void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const CommonOptions& options) {
   fs::create_directories(dir);
-  writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << sceneToJson(scene); });
+  // Rewritten only when it changes: its time tells the later stages' --resume whether their frames are stale.
+  const std::string json = sceneToJson(scene);
+  std::error_code error;
+  if (!fs::exists(dir / "scene.json", error) || readTextFile(dir / "scene.json") != json)
+    writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << json; });
   TerminalProgress progress(!options.quiet);
   const SimulationSummary summary = simulate(scene, dir, resume, progress);
   char line[256];

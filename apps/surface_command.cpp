@@ -8,10 +8,11 @@
 
 namespace surge {
 
-void runSurfaceStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options) {
+void runSurfaceStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options,
+                     bool resume) {
   const auto start = std::chrono::steady_clock::now();
   TerminalProgress progress(!options.quiet);
-  surfaceFrames(dir, scene, range, progress);
+  surfaceFrames(dir, scene, range, progress, resume);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   char line[256];
   std::snprintf(line, sizeof line, "surface: %.1f s -> %s/surface", seconds, dir.string().c_str());

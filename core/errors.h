@@ -35,6 +35,8 @@ class RunError : public Error {
 class Interrupted : public Error {
  public:
   Interrupted() : Error(kExitInterrupted, "interrupted") {}
+  // The same, with what to do next ("interrupted; <hint>").
+  explicit Interrupted(const std::string& hint) : Error(kExitInterrupted, "interrupted; " + hint) {}
 };
 
 }  // namespace surge

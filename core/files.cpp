@@ -62,6 +62,21 @@ void removeOrphanFrames(const fs::path& dir, const std::string& sub, const std::
       if (!std::binary_search(sources.begin(), sources.end(), frame)) fs::remove(framePath(dir, sub, frame, ext));
 }
 
+bool isUpToDate(const std::vector<fs::path>& outputs, const std::vector<fs::path>& inputs) {
+  std::error_code error;
+  fs::file_time_type newestInput = fs::file_time_type::min();
+  for (const fs::path& input : inputs) {
+    const auto time = fs::last_write_time(input, error);
+    if (error) return false;
+    newestInput = std::max(newestInput, time);
+  }
+  for (const fs::path& output : outputs) {
+    const auto time = fs::last_write_time(output, error);
+    if (error || time < newestInput) return false;
+  }
+  return true;
+}
+
 FrameRange FrameRange::parse(const std::string& text) {
   FrameRange range;
   const auto colon = text.find(':');

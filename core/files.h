@@ -27,6 +27,10 @@ std::vector<int> listFrames(const fs::path& dir, const std::string& sub, const s
 void removeOrphanFrames(const fs::path& dir, const std::string& sub, const std::vector<std::string>& exts,
                         const std::vector<int>& sources);
 
+// Whether every one of `outputs` exists and none is older than any of `inputs`: a frame made from these inputs
+// by an earlier run that stopped later (`surge run --resume` skips it; the bytes would be the same).
+bool isUpToDate(const std::vector<fs::path>& outputs, const std::vector<fs::path>& inputs);
+
 // An inclusive range of frames, from a --frames "A:B" flag ("A:" and ":B" leave an end open).
 struct FrameRange {
   int first = 0;

@@ -130,6 +130,13 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
                      "no " + std::string(particles ? "particle" : "surface") +
                          " frame in the range (there are frames " + std::to_string(all.front()) + " to " +
                          std::to_string(all.back()) + ")");
+  if (options.resume) {
+    const auto done = [&](int f) {
+      return isUpToDate({framePath(dir, "frames", f, "png")},
+                        {framePath(dir, particles ? "particles" : "surface", f, "ply"), dir / "scene.json"});
+    };
+    frames.erase(std::remove_if(frames.begin(), frames.end(), done), frames.end());
+  }
 
   progress.start("render", frames.size());
   if (gl) {

@@ -432,7 +432,8 @@ SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const 
   return stats;
 }
 
-void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress) {
+void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress,
+                   bool resume) {
   const std::vector<int> all = listFrames(dir, "particles", "ply");
   if (all.empty())
     throw InputError(dir.string(), "no particle frames (particles/frame_NNNNN.ply) to surface");
@@ -443,6 +444,14 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
     throw InputError(
         dir.string(), "--frames",
         "no particle frame in " + std::to_string(range.first) + ":" + std::to_string(range.last));
+  if (resume) {
+    const auto done = [&](int f) {
+      std::vector<fs::path> outputs = {framePath(dir, "surface", f, "vdb"), framePath(dir, "surface", f, "ply")};
+      if (scene.surface.write_obj) outputs.push_back(framePath(dir, "surface", f, "obj"));
+      return isUpToDate(outputs, {framePath(dir, "particles", f, "ply"), dir / "scene.json"});
+    };
+    frames.erase(std::remove_if(frames.begin(), frames.end(), done), frames.end());
+  }
   progress.start("surface", frames.size());
   // Frames in parallel, one chunk each (OpenVDB's and our own loops inside a frame share the same oneTBB
   // workers). Each frame's files depend only on its particles, so the bytes are the same at any thread count.

@@ -99,6 +99,42 @@ TEST(EndToEnd, RunMakesEveryStagesFiles) {
   EXPECT_EQ(countVideoFrames(out / "tiny.mp4"), 2);
 }
 
+TEST(EndToEnd, ResumedRunRedoesOnlyWhatIsMissingAndEndsOnTheSameBytes) {
+  const fs::path scene = writeTestScene("tiny.json", kTinyScene);
+  const fs::path out = fs::path(testing::TempDir()) / ("surge_e2e_resume_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  ASSERT_EQ(runSurge("run '" + scene.string() + "' --out '" + out.string() + "' --quiet").status, 0);
+  const fs::path mesh1 = framePath(out, "surface", 1, "ply"), vdb1 = framePath(out, "surface", 1, "vdb");
+  const fs::path png2 = framePath(out, "frames", 2, "png"), png0 = framePath(out, "frames", 0, "png");
+  const std::string meshBytes = readTextFile(mesh1), pngBytes = readTextFile(png2);
+  const auto png0Time = fs::last_write_time(png0);
+
+  // As if the run had been stopped before surfacing frame 1 and rendering frame 2 (and so frame 1).
+  fs::remove(mesh1);
+  fs::remove(vdb1);
+  fs::remove(png2);
+  fs::remove(framePath(out, "frames", 1, "png"));
+  const SurgeResult r = runSurge("run '" + scene.string() + "' --resume --out '" + out.string() + "' --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(readTextFile(mesh1), meshBytes);
+  EXPECT_EQ(readTextFile(png2), pngBytes);
+  EXPECT_EQ(fs::last_write_time(png0), png0Time) << "frame 0 was up to date and should have been left";
+  EXPECT_EQ(countVideoFrames(out / "tiny.mp4"), 4);
+
+  // A changed scene makes every frame stale: the render's size changes on every frame.
+  const SurgeResult wider = runSurge("run '" + scene.string() + "' --resume --set render.width=128 --out '" +
+                                     out.string() + "' --quiet");
+  ASSERT_EQ(wider.status, 0) << wider.err;
+  for (int f = 0; f <= 3; ++f) {
+    int width = 0, height = 0, channels = 0;
+    unsigned char* pixels = stbi_load(framePath(out, "frames", f, "png").c_str(), &width, &height, &channels, 3);
+    ASSERT_NE(pixels, nullptr);
+    EXPECT_EQ(width, 128) << "frame " << f;
+    stbi_image_free(pixels);
+  }
+  fs::remove_all(out);
+}
+
 TEST(EndToEnd, BadSceneIsOneLineExitTwoAndWritesNothing) {
   std::string text = kTinyScene;
   text.replace(text.find("\"particle_spacing\": 0.03"), 24, "\"particle_spacing\": -1");
