@@ -93,6 +93,29 @@ class TankWalls {
             }
         edge_[ta * (kEdgeTableSize + 1) + tb] = {float(w), float(-ga), float(-gb)};
       }
+    // Where three walls meet (3D): each wall added the eighth beyond all three, each of the three edges took
+    // it away; tabulate it (distances to the three walls) so add() counts it once again.
+    if constexpr (Dim == 3) {
+      constexpr int n = kEdgeTableSize + 1;
+      corner_.assign(size_t(n) * n * n, CornerEntry{});
+      for (int ta = 0; ta < n; ++ta)
+        for (int tb = 0; tb < n; ++tb)
+          for (int tc = 0; tc < n; ++tc) {
+            double w = 0, g[3] = {0, 0, 0};
+            for (int i = 0; i <= reach; ++i)
+              for (int j = 0; j <= reach; ++j)
+                for (int k = 0; k <= reach; ++k) {
+                  VecD r;
+                  r[0] = support * ta / kEdgeTableSize + particleRadius + i * spacing;
+                  r[1] = support * tb / kEdgeTableSize + particleRadius + j * spacing;
+                  r[2] = support * tc / kEdgeTableSize + particleRadius + k * spacing;
+                  w += weight(r);
+                  const VecD gr = gradient(r);
+                  for (int a = 0; a < 3; ++a) g[a] += gr[a];
+                }
+            corner_[(size_t(ta) * n + tb) * n + tc] = {float(w), {float(-g[0]), float(-g[1]), float(-g[2])}};
+          }
+    }
   }
 
   // Adds the walls' share of sum_b W(p - p_b) to `weight` and of sum_b grad W(p - p_b) to `gradient`.
@@ -108,8 +131,8 @@ class TankWalls {
         const float g = (1 - f) * gradient_[t] + f * gradient_[t + 1];
         gradient[k] += side == 0 ? -g : g;  // grad_{p_i} points towards the wall
       }
-    // Edges: the quarter beyond two walls was added by each; take it away once. (Where three walls meet, the
-    // eighth beyond all three is then missing, at the tank's eight corners only.)
+    // Edges: the quarter beyond two walls was added by each; take it away once. Corners: the eighth beyond three
+    // walls was added three times and taken away three times; add it once (inclusion-exclusion).
     for (int k = 0; k < Dim; ++k)
       for (int k2 = k + 1; k2 < Dim; ++k2)
         for (int sides = 0; sides < 4; ++sides) {
@@ -130,6 +153,7 @@ class TankWalls {
           gradient[k] -= side == 0 ? -ga : ga;
           gradient[k2] -= side2 == 0 ? -gb : gb;
         }
+    if constexpr (Dim == 3) addCorners(p, weight, gradient);
   }
 
   // Collision response: projects p back to a particle radius inside the tank. NaN stays NaN (comparisons with
@@ -154,6 +178,49 @@ class TankWalls {
   }
 
  private:
+  // The corners' share of add(): trilinear in the table of the eighth beyond three walls, for every corner
+  // whose three walls are all within the support (none, for all but the particles in a corner).
+  void addCorners(const VecD& p, float& weight, VecD& gradient) const {
+    constexpr int n = kEdgeTableSize + 1;
+    int t[3][2], sides[3][2], count[3];
+    float f[3][2];
+    for (int k = 0; k < 3; ++k) {
+      count[k] = 0;
+      for (int side = 0; side < 2; ++side) {
+        const float d = side ? domainMax_[k] - p[k] : p[k] - domainMin_[k];
+        const float u = std::max(d, 0.0f) * edgeScale_;
+        if (!(u < kEdgeTableSize)) continue;  // also skips NaN
+        const int c = count[k]++;
+        sides[k][c] = side;
+        t[k][c] = static_cast<int>(u);
+        f[k][c] = u - t[k][c];
+      }
+      if (count[k] == 0) return;
+    }
+    for (int i = 0; i < count[0]; ++i)
+      for (int j = 0; j < count[1]; ++j)
+        for (int l = 0; l < count[2]; ++l) {
+          const int at[3] = {t[0][i], t[1][j], t[2][l]};
+          const float fr[3] = {f[0][i], f[1][j], f[2][l]};
+          float w = 0, g[3] = {0, 0, 0};
+          for (int c = 0; c < 8; ++c) {
+            float s = 1;
+            int index[3];
+            for (int k = 0; k < 3; ++k) {
+              const int up = (c >> k) & 1;
+              s *= up ? fr[k] : 1 - fr[k];
+              index[k] = at[k] + up;
+            }
+            const CornerEntry& entry = corner_[(size_t(index[0]) * n + index[1]) * n + index[2]];
+            w += s * entry.weight;
+            for (int k = 0; k < 3; ++k) g[k] += s * entry.gradient[k];
+          }
+          weight += w;
+          const int side[3] = {sides[0][i], sides[1][j], sides[2][l]};
+          for (int k = 0; k < 3; ++k) gradient[k] += side[k] ? g[k] : -g[k];
+        }
+  }
+
   static constexpr int kTableSize = 64;
   static constexpr int kEdgeTableSize = 32;
   struct EdgeEntry {
@@ -164,6 +231,10 @@ class TankWalls {
   float tableScale_ = 0;
   std::vector<EdgeEntry> edge_;
   float edgeScale_ = 0;
+  struct CornerEntry {
+    float weight = 0, gradient[3] = {0, 0, 0};  // gradient: magnitudes towards each of the three walls
+  };
+  std::vector<CornerEntry> corner_;
 };
 
 }  // namespace surge
