@@ -2,18 +2,47 @@
 #include <chrono>
 #include <cstdio>
 
+#include <nlohmann/json.hpp>
+
 #include "apps/commands.h"
+#include "core/errors.h"
 #include "core/parallel.h"
 #include "sim/simulation.h"
 
 namespace surge {
 
+namespace {
+
+// A resumed simulation must go on with the physics it started with: the scene may change its name, its
+// surfacing, its rendering and its number of frames, nothing else. Throws InputError naming the first key
+// that differs from the folder's scene.json.
+void checkResumable(const fs::path& previous, const std::string& json) {
+  auto physics = [](nlohmann::json scene) {
+    for (const char* key : {"name", "surface", "render"}) scene.erase(key);
+    if (scene.contains("output")) scene["output"].erase("frames");
+    return scene;
+  };
+  const nlohmann::json patch =
+      nlohmann::json::diff(physics(nlohmann::json::parse(readTextFile(previous))), physics(nlohmann::json::parse(json)));
+  if (patch.empty()) return;
+  std::string key = patch.front().value("path", "");
+  for (char& c : key) c = c == '/' ? '.' : c;
+  if (!key.empty() && key.front() == '.') key.erase(0, 1);
+  throw InputError(previous.string(), key,
+                   "differs from the scene this folder was simulated with; --resume needs the same physics "
+                   "(run without it to start over)");
+}
+
+}  // namespace
+
 void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const CommonOptions& options) {
-  fs::create_directories(dir);
-  // Rewritten only when it changes: its time tells the later stages' --resume whether their frames are stale.
   const std::string json = sceneToJson(scene);
   std::error_code error;
-  if (!fs::exists(dir / "scene.json", error) || readTextFile(dir / "scene.json") != json)
+  const bool existing = fs::exists(dir / "scene.json", error);
+  if (resume && existing && !listFrames(dir, "particles", "ply").empty()) checkResumable(dir / "scene.json", json);
+  fs::create_directories(dir);
+  // Rewritten only when it changes: its time tells the later stages' --resume whether their frames are stale.
+  if (!existing || readTextFile(dir / "scene.json") != json)
     writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << json; });
   TerminalProgress progress(!options.quiet);
   const SimulationSummary summary = simulate(scene, dir, resume, progress);

@@ -62,6 +62,26 @@ TEST(SimCommand, DivergenceStopsWithFrameSubstepAndParticle) {
   EXPECT_EQ(readParticlePly(framePath(out, "particles", 0, "ply")).size(), 8u);
 }
 
+TEST(SimCommand, ResumeRefusesChangedPhysicsButTakesMoreFramesAndOtherRendering) {
+  const fs::path scene = writeTestScene("small.json", kSmallDamBreak);
+  const fs::path out = freshFolder("surge_resume_changed");
+  const std::string base = "sim '" + scene.string() + "' --quiet --out " + out.string();
+  ASSERT_EQ(runSurge(base + " --set output.frames=2").status, 0);
+  const std::string frame2 = readTextFile(framePath(out, "particles", 2, "ply"));
+
+  const SurgeResult changed = runSurge(base + " --resume --set output.frames=3 --set solver.iterations=7");
+  EXPECT_EQ(changed.status, 2) << changed.err;
+  EXPECT_NE(changed.err.find((out / "scene.json").string() + ": solver.iterations: differs"), std::string::npos)
+      << changed.err;
+  EXPECT_EQ(std::count(changed.err.begin(), changed.err.end(), '\n'), 1) << changed.err;
+  EXPECT_EQ(listFrames(out, "particles", "ply"), (std::vector<int>{0, 1, 2}));  // nothing written
+  EXPECT_EQ(readTextFile(framePath(out, "particles", 2, "ply")), frame2);
+
+  const SurgeResult more = runSurge(base + " --resume --set output.frames=3 --set render.width=320");
+  EXPECT_EQ(more.status, 0) << more.err;
+  EXPECT_EQ(listFrames(out, "particles", "ply"), (std::vector<int>{0, 1, 2, 3}));
+}
+
 TEST(SimCommand, ResumeAfterKillEndsOnTheSameBytes) {
   const fs::path scene = writeTestScene("small.json", kSmallDamBreak);
   const fs::path whole = freshFolder("surge_whole"), resumed = freshFolder("surge_resumed");
