@@ -130,6 +130,33 @@ AnisotropicKernels anisotropicKernels(const std::vector<Eigen::Vector3f>& x, con
   const double ks = 1 / latticeVariance(p.spacing, r);
   const CellGrid grid(x, r);
   std::vector<float> extent(n);
+  // Deep particles: every cell within 3 cells of theirs holds a particle. A free surface passes through cells
+  // that border an empty one, so it is at least 2 cells (6 spacings) away: beyond their kernel's support (2
+  // spacings) and the level set's band (at most 2), so their kernels' shapes cannot reach the surface, and
+  // they keep the interior's isotropic kernel, G = I / h (what the PCA gives on the rest lattice), without
+  // the PCA. (A bubble smaller than a cell is filled, as the rasteriser's skipping of blocks inside does.)
+  const auto deepCells = [&] {
+    const Eigen::Vector3i& d = grid.dims;
+    std::vector<uint8_t> deep(size_t(d.x()) * d.y() * d.z(), 0);
+    parallelFor(0, deep.size(), [&](size_t begin, size_t end) {
+      for (size_t c = begin; c < end; ++c) {
+        const Eigen::Vector3i at(int(c % size_t(d.x())), int((c / size_t(d.x())) % size_t(d.y())),
+                                 int(c / (size_t(d.x()) * d.y())));
+        bool full = true;
+        for (int z = at.z() - 3; z <= at.z() + 3 && full; ++z)
+          for (int y = at.y() - 3; y <= at.y() + 3 && full; ++y)
+            for (int x0 = at.x() - 3; x0 <= at.x() + 3 && full; ++x0) {
+              if (x0 < 0 || y < 0 || z < 0 || x0 >= d.x() || y >= d.y() || z >= d.z()) full = false;
+              else {
+                const size_t cell = grid.index(Eigen::Vector3i(x0, y, z));
+                full = grid.start[cell + 1] > grid.start[cell];
+              }
+            }
+        deep[c] = full;
+      }
+    });
+    return deep;
+  }();
 
   const double r2 = r * r;
   // Particles in the grid's cell order, so that neighbouring particles' neighbours are still in cache; each
@@ -138,6 +165,12 @@ AnisotropicKernels anisotropicKernels(const std::vector<Eigen::Vector3f>& x, con
     std::vector<std::pair<uint32_t, double>> within;  // the neighbours j with their weights w_ij
     for (size_t k = begin; k < end; ++k) {
       const size_t i = grid.order[k];
+      if (deepCells[grid.index(grid.cellOf(x[i]))]) {
+        out.centre[i] = x[i];
+        out.G[i] = Eigen::Matrix3f::Identity() / float(h);
+        extent[i] = float(h);
+        continue;
+      }
       const Eigen::Vector3d xi = x[i].cast<double>();
       // Step 2: the weighted mean, then the covariance about it (two passes, for accuracy in float data).
       double sumW = 0;
