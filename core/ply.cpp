@@ -1,5 +1,6 @@
 #include "core/ply.h"
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -27,8 +28,8 @@ struct PlyElement {
 
 int typeSize(const std::string& type) {
   static const std::map<std::string, int> sizes = {
-      {"char", 1},  {"uchar", 1},  {"int8", 1},    {"uint8", 1},   {"short", 2},  {"ushort", 2},
-      {"int16", 2}, {"uint16", 2}, {"int", 4},     {"uint", 4},    {"int32", 4},  {"uint32", 4},
+      {"char", 1},  {"uchar", 1},   {"int8", 1},   {"uint8", 1},  {"short", 2}, {"ushort", 2},
+      {"int16", 2}, {"uint16", 2},  {"int", 4},    {"uint", 4},   {"int32", 4}, {"uint32", 4},
       {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
   auto it = sizes.find(type);
   return it == sizes.end() ? 0 : it->second;
@@ -81,7 +82,8 @@ PlyFile parsePly(const fs::path& path) {
     if (word == "format") {
       std::string format;
       words >> format;
-      if (format != "binary_little_endian") fail("format '" + format + "' is not supported (binary_little_endian)");
+      if (format != "binary_little_endian")
+        fail("format '" + format + "' is not supported (binary_little_endian)");
       sawFormat = true;
     } else if (word == "comment" || word == "obj_info") {
       file.comments.push_back(line.size() > 8 ? line.substr(8) : "");
@@ -125,8 +127,8 @@ PlyFile parsePly(const fs::path& path) {
       bytes.resize(recordSize * element.count);
       in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
       if (static_cast<size_t>(in.gcount()) != bytes.size())
-        throw InputError(where, "element " + element.name, "file ends before its " +
-                                                               std::to_string(element.count) + " records");
+        throw InputError(where, "element " + element.name,
+                         "file ends before its " + std::to_string(element.count) + " records");
     } else {
       // Lists: read record by record, keeping the raw bytes.
       for (size_t r = 0; r < element.count; ++r) {
@@ -173,7 +175,8 @@ std::vector<std::vector<double>> readColumns(const PlyFile& file, size_t element
   int recordSize = 0;
   for (const PlyProperty& p : element.properties) {
     if (!p.countType.empty())
-      throw InputError(where, "element " + element.name, "list property '" + p.name + "' is not expected here");
+      throw InputError(where, "element " + element.name,
+                       "list property '" + p.name + "' is not expected here");
     for (size_t n = 0; n < names.size(); ++n)
       if (p.name == names[n]) {
         offsets[n] = recordSize;
@@ -233,10 +236,19 @@ ParticleFrame readParticlePly(const fs::path& path) {
                                    {false, false, false, false, false, false, true}, where);
   ParticleFrame frame;
   for (const std::string& comment : file.comments)
-    if (comment.rfind("dimensions ", 0) == 0) frame.dimensions = std::stoi(comment.substr(11));
+    if (comment.rfind("dimensions ", 0) == 0) {
+      const std::string value = comment.substr(11);
+      if (value != "2" && value != "3")
+        throw InputError(where, "comment dimensions", "must be 2 or 3, not '" + value + "'");
+      frame.dimensions = value[0] - '0';
+    }
   const size_t n = file.elements[index].count;
   frame.resize(n);
+  const char* names[6] = {"x", "y", "z", "vx", "vy", "vz"};
   for (size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 6; ++k)
+      if (!std::isfinite(float(columns[size_t(k)][i])))
+        throw InputError(where, "vertex " + std::to_string(i) + " " + names[k], "not a finite number");
     frame.position[i] = Eigen::Vector3f(float(columns[0][i]), float(columns[1][i]), float(columns[2][i]));
     frame.velocity[i] = Eigen::Vector3f(float(columns[3][i]), float(columns[4][i]), float(columns[5][i]));
     frame.id[i] = columns[6].empty() ? static_cast<uint32_t>(i) : static_cast<uint32_t>(columns[6][i]);
@@ -295,8 +307,7 @@ TriangleMesh readMeshPly(const fs::path& path) {
     std::vector<uint32_t> polygon(items);
     for (size_t k = 0; k < items; ++k, p += itemSize) {
       polygon[k] = static_cast<uint32_t>(readScalar(p, list.type));
-      if (polygon[k] >= n)
-        throw InputError(where, "face " + std::to_string(f), "vertex index out of range");
+      if (polygon[k] >= n) throw InputError(where, "face " + std::to_string(f), "vertex index out of range");
     }
     for (size_t k = 1; k + 1 < items; ++k) mesh.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
   }

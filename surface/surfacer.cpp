@@ -104,6 +104,16 @@ Parameters resolve(const ParticleFrame& frame, const Scene& scene) {
   return p;
 }
 
+// The first particle more than 2^22 voxels from the origin on some axis, or -1: the blocks of 8^3 voxels are
+// keyed by 21-bit coordinates (particle_field.cpp, narrow_band.cpp), 2^23 voxels each way, and half that
+// leaves room for the band. (The scene check keeps the domain inside it; a particle file may not be.)
+long farParticle(const ParticleFrame& frame, double voxel) {
+  const double limit = double(1 << 22) * voxel;
+  for (size_t i = 0; i < frame.size(); ++i)
+    if (frame.position[i].cast<double>().cwiseAbs().maxCoeff() > limit) return long(i);
+  return -1;
+}
+
 // Particles as the surfacer sees them: the frame's, or in 2D 2 * kSlabHalfLayers + 1 copies of them spaced
 // particle_spacing along z (positions; velocities are copied with vz = 0).
 std::vector<Eigen::Vector3f> slabPositions(const ParticleFrame& frame, const Parameters& p,
@@ -279,6 +289,8 @@ FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
   if (p.radius / p.voxel < 1.5)
     throw RunError("surface: particle_radius " + std::to_string(p.radius) + " is under 1.5 voxels of " +
                    std::to_string(p.voxel) + "; the particles' spheres would be lost");
+  if (const long far = farParticle(frame, p.voxel); far >= 0)
+    throw RunError("surface: particle " + std::to_string(far) + " lies more than 2^22 voxels from the origin");
   const int steps = scene.surface.smoothing_steps;
   FloatGrid::Ptr grid =
       p.method == "spheres" ? sphereLevelSet(frame, p, steps) : blendedLevelSet(frame, p, steps);
@@ -462,7 +474,11 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
         for (size_t i = begin; i < end; ++i) {
           Progress::checkInterrupt();
           const int f = frames[i];
-          const ParticleFrame frame = readParticlePly(framePath(dir, "particles", f, "ply"));
+          const fs::path path = framePath(dir, "particles", f, "ply");
+          const ParticleFrame frame = readParticlePly(path);
+          if (const long far = farParticle(frame, resolve(frame, scene).voxel); far >= 0)
+            throw InputError(path.string(), "vertex " + std::to_string(far),
+                             "lies more than 2^22 voxels (surface.voxel_size) from the origin");
           surfaceFrame(frame, scene, framePath(dir, "surface", f, "vdb"),
                        framePath(dir, "surface", f, "ply"));
           const std::lock_guard<std::mutex> lock(advance);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 
 #include "core/errors.h"
 
@@ -85,6 +86,18 @@ TEST(Ply, BadFilesNameFileAndPlace) {
         << e.what();
   }
   EXPECT_THROW(readParticlePly(tempPath("missing.ply")), InputError);
+
+  // A diverged or hand-made frame with a non-finite value names the particle and the field.
+  for (size_t i = 0; i < frame.size(); ++i) frame.position[i] = frame.velocity[i] = Eigen::Vector3f::Zero();
+  frame.velocity[7].y() = std::numeric_limits<float>::infinity();
+  writeParticlePly(path, frame);
+  try {
+    readParticlePly(path);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.ply: vertex 7 vy: not a finite number"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -355,6 +355,22 @@ TEST(Surfacer, SurfaceFramesWritesEveryFrameInRange) {
   EXPECT_THROW(surfaceFrames(dir, scene, FrameRange{}, progress), Interrupted);
   EXPECT_THROW(meshParticles(block(3, 3, 3, h, Eigen::Vector3d::Zero()), scene), Interrupted);
   Progress::setInterrupted(false);
+  // A particle far beyond any tank (a hand-made file): one line naming the file and the particle, nothing
+  // else written; meshParticles refuses it too.
+  ParticleFrame far = block(3, 3, 3, h, Eigen::Vector3d::Zero());
+  far.position[5].x() = 1e6f;
+  writeParticlePly(framePath(dir, "particles", 3, "ply"), far);
+  range.first = 3;
+  try {
+    surfaceFrames(dir, scene, range, progress);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("frame_00003.ply: vertex 5: lies more than 2^22 voxels"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(fs::exists(framePath(dir, "surface", 3, "vdb")));
+  EXPECT_THROW(meshParticles(far, scene), RunError);
   fs::remove_all(dir);
 }
 
