@@ -7,7 +7,7 @@
 # FRAME_DIR is an output folder of `surge sim` (scene.json + particles/); make a ~1M-particle dam break with
 #   surge sim scenes/dam_break.json --set particle_spacing=0.0056 --set output.frames=1 --out /tmp/dam1m --quiet
 set -euo pipefail
-surge=${1:-build-surface/apps/surge}
+surge=${1:-build/apps/surge}
 dir=${2:-/tmp/dam1m}
 frame=${3:-1}
 work=$(mktemp -d)
