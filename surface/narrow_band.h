@@ -6,7 +6,8 @@
 // differ because the erosion that follows the smoothing moves the surface inward, so the inside must reach
 // that much deeper than the final band. A block missing from the field lies wholly on one side of the
 // surface: its voxels read as the clamp value of the sign of the nearest voxel of the block beside it (a
-// block next to the band is never missing: the rasteriser keeps every block with a voxel in the band).
+// block next to the band is never missing: the rasteriser, like OpenVDB's pruning, keeps every block with a
+// voxel in the band).
 //
 // Every operation is Jacobi (reads the field before it, writes a new one), so the values are the same bytes
 // at any thread count.
