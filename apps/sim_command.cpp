@@ -41,6 +41,12 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   const bool existing = fs::exists(dir / "scene.json", error);
   if (resume && existing && !listFrames(dir, "particles", "ply").empty()) checkResumable(dir / "scene.json", json);
   fs::create_directories(dir);
+  if (!resume) {
+    // A new simulation: whatever the later stages made from an earlier one in this folder is stale (a shorter
+    // run would otherwise end in a video of the older run's later frames).
+    removeFrames(dir, "surface", {"vdb", "ply", "obj"});
+    removeFrames(dir, "frames", {"png"});
+  }
   // Rewritten only when it changes: its time tells the later stages' --resume whether their frames are stale.
   if (!existing || readTextFile(dir / "scene.json") != json)
     writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << json; });

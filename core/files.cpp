@@ -55,11 +55,9 @@ std::vector<int> listFrames(const fs::path& dir, const std::string& sub, const s
   return frames;
 }
 
-void removeOrphanFrames(const fs::path& dir, const std::string& sub, const std::vector<std::string>& exts,
-                        const std::vector<int>& sources) {
+void removeFrames(const fs::path& dir, const std::string& sub, const std::vector<std::string>& exts) {
   for (const std::string& ext : exts)
-    for (int frame : listFrames(dir, sub, ext))
-      if (!std::binary_search(sources.begin(), sources.end(), frame)) fs::remove(framePath(dir, sub, frame, ext));
+    for (int frame : listFrames(dir, sub, ext)) fs::remove(framePath(dir, sub, frame, ext));
 }
 
 bool isUpToDate(const std::vector<fs::path>& outputs, const std::vector<fs::path>& inputs) {

@@ -21,11 +21,8 @@ fs::path framePath(const fs::path& dir, const std::string& sub, int frame, const
 // The frame numbers of the dir/sub/frame_NNNNN.ext files present, sorted.
 std::vector<int> listFrames(const fs::path& dir, const std::string& sub, const std::string& ext);
 
-// Removes dir/sub/frame_NNNNN.ext, for each of `exts`, of every frame not in `sources`: the outputs of an earlier
-// run whose source frame is gone (a run of fewer frames into the same folder), which the next stage would
-// otherwise take for this run's.
-void removeOrphanFrames(const fs::path& dir, const std::string& sub, const std::vector<std::string>& exts,
-                        const std::vector<int>& sources);
+// Removes every dir/sub/frame_NNNNN.ext, for each of `exts`.
+void removeFrames(const fs::path& dir, const std::string& sub, const std::vector<std::string>& exts);
 
 // Whether every one of `outputs` exists and none is older than any of `inputs`: a frame made from these inputs
 // by an earlier run that stopped later (`surge run --resume` skips it; the bytes would be the same).

@@ -122,7 +122,6 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
     throw InputError(dir.string(),
                      gl ? "no surface/ or particles/frame_NNNNN.ply to render; run surge sim first"
                         : "no surface/frame_NNNNN.ply meshes to render; run surge surface first");
-  removeOrphanFrames(dir, "frames", {"png"}, all);
   std::vector<int> frames;
   std::copy_if(all.begin(), all.end(), std::back_inserter(frames), [&](int f) { return range.contains(f); });
   if (frames.empty())

@@ -449,7 +449,6 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
   const std::vector<int> all = listFrames(dir, "particles", "ply");
   if (all.empty())
     throw InputError(dir.string(), "no particle frames (particles/frame_NNNNN.ply) to surface");
-  removeOrphanFrames(dir, "surface", {"vdb", "ply", "obj"}, all);
   std::vector<int> frames;
   std::copy_if(all.begin(), all.end(), std::back_inserter(frames), [&](int f) { return range.contains(f); });
   if (frames.empty())
