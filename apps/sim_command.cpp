@@ -1,7 +1,6 @@
 // surge sim SCENE: simulate a scene into particle frames and stats.csv.
 #include <chrono>
 #include <cstdio>
-
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
@@ -16,14 +15,14 @@ namespace {
 // A resumed simulation must go on with the physics it started with: the scene may change its name, its
 // surfacing, its rendering and its number of frames, nothing else. Throws InputError naming the first key
 // that differs from the folder's scene.json.
-void checkResumable(const fs::path& previous, const std::string& json) {
+void checkResumable(const fs::path& previous, const std::string& previousJson, const std::string& json) {
   auto physics = [](nlohmann::json scene) {
     for (const char* key : {"name", "surface", "render"}) scene.erase(key);
     if (scene.contains("output")) scene["output"].erase("frames");
     return scene;
   };
-  const nlohmann::json patch =
-      nlohmann::json::diff(physics(nlohmann::json::parse(readTextFile(previous))), physics(nlohmann::json::parse(json)));
+  const nlohmann::json patch = nlohmann::json::diff(physics(nlohmann::json::parse(previousJson)),
+                                                    physics(nlohmann::json::parse(json)));
   if (patch.empty()) return;
   std::string key = patch.front().value("path", "");
   for (char& c : key) c = c == '/' ? '.' : c;
@@ -39,7 +38,9 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   const std::string json = sceneToJson(scene);
   std::error_code error;
   const bool existing = fs::exists(dir / "scene.json", error);
-  if (resume && existing && !listFrames(dir, "particles", "ply").empty()) checkResumable(dir / "scene.json", json);
+  const std::string previous = existing ? readTextFile(dir / "scene.json") : std::string();
+  if (resume && existing && !listFrames(dir, "particles", "ply").empty())
+    checkResumable(dir / "scene.json", previous, json);
   fs::create_directories(dir);
   if (!resume) {
     // A new simulation: whatever the later stages made from an earlier one in this folder is stale (a shorter
@@ -48,13 +49,14 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
     removeFrames(dir, "frames", {"png"});
   }
   // Rewritten only when it changes: its time tells the later stages' --resume whether their frames are stale.
-  if (!existing || readTextFile(dir / "scene.json") != json)
+  if (!existing || previous != json)
     writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << json; });
   TerminalProgress progress(!options.quiet);
   const SimulationSummary summary = simulate(scene, dir, resume, progress);
   char line[256];
-  std::snprintf(line, sizeof line, "sim: %zu particles, frames %d-%d in %.1f s -> %s/particles", summary.particles,
-                summary.firstFrame, summary.lastFrame, summary.wallSeconds, dir.string().c_str());
+  std::snprintf(line, sizeof line, "sim: %zu particles, frames %d-%d in %.1f s -> %s/particles",
+                summary.particles, summary.firstFrame, summary.lastFrame, summary.wallSeconds,
+                dir.string().c_str());
   say(options, line);
 }
 
@@ -65,9 +67,11 @@ void addSimCommand(CLI::App& app) {
     bool resume = false;
   };
   auto options = std::make_shared<Options>();
-  CLI::App* command = app.add_subcommand("sim", "simulate a scene into particles/frame_NNNNN.ply and stats.csv");
+  CLI::App* command =
+      app.add_subcommand("sim", "simulate a scene into particles/frame_NNNNN.ply and stats.csv");
   command->add_option("scene", options->scene, "scene file (JSON)")->required();
-  command->add_flag("--resume", options->resume, "continue from the last complete frame in the output folder");
+  command->add_flag("--resume", options->resume,
+                    "continue from the last complete frame in the output folder");
   addCommonOptions(*command, options->common, true);
   command->callback([options] {
     const Scene scene = loadScene(options->scene, options->common.overrides);

@@ -139,7 +139,10 @@ void visitScene(Scene& s, SceneVisitor& v) {
              info("level set: spheres (union of particle spheres), smooth_spheres (Zhu & Bridson 2005 blend), "
                   "anisotropic (Yu & Turk 2013 ellipsoids from neighbour PCA); see docs/performance.md"));
     v.integer("smoothing_steps", s.surface.smoothing_steps,
-              atLeast(0, "mean-curvature smoothing steps of the level set, each moving the surface by at most a third of a voxel times its curvature in voxels; 0 turns smoothing off", "", 100));
+              atLeast(0,
+                      "mean-curvature smoothing steps of the level set, each moving the surface by at most a "
+                      "third of a voxel times its curvature in voxels; 0 turns smoothing off",
+                      "", 100));
     v.integer("write_velocity", s.surface.write_velocity,
               atLeast(0, "1: the VDB also holds a velocity grid `v` (particle velocities, kernel-averaged)", "", 1));
     v.integer("write_points", s.surface.write_points,

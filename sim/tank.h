@@ -2,8 +2,8 @@
 //  - latticeSums: sums of a kernel and of its squared gradient over the rest lattice around an interior
 //    particle, to choose the particle mass (the rest lattice has exactly rho_0) and scale PBF's epsilon;
 //  - TankWalls: the tank's walls as the rest lattice continued beyond them (after the boundary particles of
-//    Akinci et al. 2012, summed once, up front, into tables against the distance to the wall), so a particle of
-//    the rest lattice next to a wall has rho_0 as an interior one does and is pushed off the wall by the
+//    Akinci et al. 2012, summed once, up front, into tables against the distance to the wall), so a particle
+//    of the rest lattice next to a wall has rho_0 as an interior one does and is pushed off the wall by the
 //    density it sees; and the collision response that keeps particle centres a particle radius inside.
 #pragma once
 
@@ -51,26 +51,19 @@ class TankWalls {
     clampMin_ = domainMin + VecD::Constant(particleRadius);
     clampMax_ = domainMax - VecD::Constant(particleRadius);
     // A particle at distance d from a wall sees lattice layers at d + spacing / 2 + k spacing beyond it,
-    // tangentially aligned with the particle. The wall normal is taken along axis 0 here.
+    // tangentially aligned with the particle. The walls' normals are taken along axes 0, 1, 2 here.
     const int reach = static_cast<int>(std::ceil(support / spacing)) + 1;
+    const auto beyond = [&](int walls, const float* d, double* g) {
+      return sumBeyond(walls, d, spacing, reach, weight, gradient, g);
+    };
     weight_.assign(kTableSize + 1, 0.0f);
     gradient_.assign(kTableSize + 1, 0.0f);
     tableScale_ = kTableSize / support;
     for (int t = 0; t <= kTableSize; ++t) {
-      const float d = support * t / kTableSize;
-      double w = 0, g = 0;
-      for (int layer = 0; layer <= reach; ++layer)
-        for (int a = -reach; a <= reach; ++a)
-          for (int b = (Dim == 3 ? -reach : 0); b <= (Dim == 3 ? reach : 0); ++b) {
-            VecD r = VecD::Zero();
-            r[0] = d + particleRadius + layer * spacing;
-            r[1] = a * spacing;
-            if constexpr (Dim == 3) r[2] = b * spacing;
-            w += weight(r);
-            g += gradient(r)[0];  // <= 0: towards the wall
-          }
-      weight_[t] = static_cast<float>(w);
-      gradient_[t] = static_cast<float>(-g);
+      const float d[1] = {support * t / kTableSize};
+      double g[3];
+      weight_[t] = static_cast<float>(beyond(1, d, g));
+      gradient_[t] = static_cast<float>(-g[0]);  // g[0] <= 0: towards the wall
     }
     // Along an edge where two walls meet, both walls' lattices hold the quarter beyond both: tabulate that
     // quarter (distances dA, dB to the two walls) so add() can count it once.
@@ -78,20 +71,10 @@ class TankWalls {
     edge_.assign((kEdgeTableSize + 1) * (kEdgeTableSize + 1), EdgeEntry{});
     for (int ta = 0; ta <= kEdgeTableSize; ++ta)
       for (int tb = 0; tb <= kEdgeTableSize; ++tb) {
-        double w = 0, ga = 0, gb = 0;
-        for (int i = 0; i <= reach; ++i)
-          for (int j = 0; j <= reach; ++j)
-            for (int c = (Dim == 3 ? -reach : 0); c <= (Dim == 3 ? reach : 0); ++c) {
-              VecD r = VecD::Zero();
-              r[0] = support * ta / kEdgeTableSize + particleRadius + i * spacing;
-              r[1] = support * tb / kEdgeTableSize + particleRadius + j * spacing;
-              if constexpr (Dim == 3) r[2] = c * spacing;
-              w += weight(r);
-              const VecD g = gradient(r);
-              ga += g[0];
-              gb += g[1];
-            }
-        edge_[ta * (kEdgeTableSize + 1) + tb] = {float(w), float(-ga), float(-gb)};
+        const float d[2] = {support * ta / kEdgeTableSize, support * tb / kEdgeTableSize};
+        double g[3];
+        const double w = beyond(2, d, g);
+        edge_[ta * (kEdgeTableSize + 1) + tb] = {float(w), float(-g[0]), float(-g[1])};
       }
     // Where three walls meet (3D): each wall added the eighth beyond all three, each of the three edges took
     // it away; tabulate it (distances to the three walls) so add() counts it once again.
@@ -101,18 +84,10 @@ class TankWalls {
       for (int ta = 0; ta < n; ++ta)
         for (int tb = 0; tb < n; ++tb)
           for (int tc = 0; tc < n; ++tc) {
-            double w = 0, g[3] = {0, 0, 0};
-            for (int i = 0; i <= reach; ++i)
-              for (int j = 0; j <= reach; ++j)
-                for (int k = 0; k <= reach; ++k) {
-                  VecD r;
-                  r[0] = support * ta / kEdgeTableSize + particleRadius + i * spacing;
-                  r[1] = support * tb / kEdgeTableSize + particleRadius + j * spacing;
-                  r[2] = support * tc / kEdgeTableSize + particleRadius + k * spacing;
-                  w += weight(r);
-                  const VecD gr = gradient(r);
-                  for (int a = 0; a < 3; ++a) g[a] += gr[a];
-                }
+            const float d[3] = {support * ta / kEdgeTableSize, support * tb / kEdgeTableSize,
+                                support * tc / kEdgeTableSize};
+            double g[3];
+            const double w = beyond(3, d, g);
             corner_[(size_t(ta) * n + tb) * n + tc] = {float(w), {float(-g[0]), float(-g[1]), float(-g[2])}};
           }
     }
@@ -131,8 +106,8 @@ class TankWalls {
         const float g = (1 - f) * gradient_[t] + f * gradient_[t + 1];
         gradient[k] += side == 0 ? -g : g;  // grad_{p_i} points towards the wall
       }
-    // Edges: the quarter beyond two walls was added by each; take it away once. Corners: the eighth beyond three
-    // walls was added three times and taken away three times; add it once (inclusion-exclusion).
+    // Edges: the quarter beyond two walls was added by each; take it away once. Corners: the eighth beyond
+    // three walls was added three times and taken away three times; add it once (inclusion-exclusion).
     for (int k = 0; k < Dim; ++k)
       for (int k2 = k + 1; k2 < Dim; ++k2)
         for (int sides = 0; sides < 4; ++sides) {
@@ -146,7 +121,8 @@ class TankWalls {
           auto at = [&](int a, int b) { return edge_[a * (kEdgeTableSize + 1) + b]; };
           const EdgeEntry e00 = at(t, t2), e01 = at(t, t2 + 1), e10 = at(t + 1, t2), e11 = at(t + 1, t2 + 1);
           auto blend = [&](float EdgeEntry::*field) {
-            return (1 - f) * ((1 - f2) * e00.*field + f2 * e01.*field) + f * ((1 - f2) * e10.*field + f2 * e11.*field);
+            return (1 - f) * ((1 - f2) * e00.*field + f2 * e01.*field) +
+                   f * ((1 - f2) * e10.*field + f2 * e11.*field);
           };
           weight -= blend(&EdgeEntry::weight);
           const float ga = blend(&EdgeEntry::gradientA), gb = blend(&EdgeEntry::gradientB);
@@ -178,6 +154,34 @@ class TankWalls {
   }
 
  private:
+  // Over the lattice beyond `walls` walls whose normals are axes 0 .. walls-1, at distances d[a] from the
+  // particle (layers d[a] + spacing / 2 + i spacing, i >= 0, on those axes; every tangential offset within
+  // `reach` on the others): returns the sum of weight(r) and writes the sum of gradient(r) to g.
+  template <typename Weight, typename Gradient>
+  static double sumBeyond(int walls, const float* d, float spacing, int reach, const Weight& weight,
+                          const Gradient& gradient, double* g) {
+    const float particleRadius = 0.5f * spacing;
+    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int a = 0; a < Dim; ++a) {
+      lo[a] = a < walls ? 0 : -reach;
+      hi[a] = reach;
+    }
+    double w = 0;
+    g[0] = g[1] = g[2] = 0;
+    for (int i = lo[0]; i <= hi[0]; ++i)
+      for (int j = lo[1]; j <= hi[1]; ++j)
+        for (int k = lo[2]; k <= hi[2]; ++k) {
+          const int index[3] = {i, j, k};
+          VecD r;
+          for (int a = 0; a < Dim; ++a)
+            r[a] = a < walls ? d[a] + particleRadius + index[a] * spacing : index[a] * spacing;
+          w += weight(r);
+          const VecD gr = gradient(r);
+          for (int a = 0; a < Dim; ++a) g[a] += gr[a];
+        }
+    return w;
+  }
+
   // The corners' share of add(): trilinear in the table of the eighth beyond three walls, for every corner
   // whose three walls are all within the support (none, for all but the particles in a corner).
   void addCorners(const VecD& p, float& weight, VecD& gradient) const {

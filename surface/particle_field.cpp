@@ -254,7 +254,6 @@ BlockField rasterizeField(const FieldParticles& particles, const FieldParameters
                                   sorted.order.begin() + sorted.start[s + 1]);
               }
           if (candidates.empty() && !only) continue;
-          std::fill(acc.begin(), acc.end(), 0.f);
           if (p.kind == FieldKind::Spheres) {
             // A minimum is exact in any order, so the candidates need no sorting; the loops skip the corners
             // of each particle's box beyond its extent (values there would be over the band, clamped anyway)
@@ -265,6 +264,7 @@ BlockField rasterizeField(const FieldParticles& particles, const FieldParameters
             // The neighbouring blocks come in key order, particles in index order within each: sort once more
             // so the sum order is the particle order, independent of how the blocks were visited.
             std::sort(candidates.begin(), candidates.end());
+            std::fill(acc.begin(), acc.end(), 0.f);
             stampWeights(particles, p, centre, candidates, o, extentVoxels, acc.data());
           }
           std::unique_ptr<float[]> values(new float[size_t(kBlockVoxels) * channels]);

@@ -209,10 +209,16 @@ double erosionOf(const Parameters& p) {
   return -kAnisoInset * p.spacing;
 }
 
-// The steps after the field is a distance, on NarrowBand: smoothing, erosion, each followed by Eikonal
-// iterations, then trimmed to the band. The field's inside reaches deeper than the band by the erosion and a
-// voxel more, so that the eroded band is whole.
-FloatGrid::Ptr smoothAndErode(NarrowBand& field, const Parameters& p, int smoothingSteps) {
+// The level-set steps on NarrowBand: `firstIterations` Eikonal iterations (to make the field a distance, if
+// it is not one yet), smoothing, erosion, each followed by Eikonal iterations, then trimmed to the band. The
+// field's inside reaches deeper than the band by the erosion and a voxel more, so that the eroded band is
+// whole.
+FloatGrid::Ptr smoothAndErode(BlockField blocks, const Parameters& p, int smoothingSteps,
+                              int firstIterations) {
+  const double band = kHalfWidthVoxels * p.voxel;
+  NarrowBand field(std::move(blocks), p.voxel, float(band),
+                   float(band + std::max(erosionOf(p), 0.0) + p.voxel));
+  field.redistance(firstIterations);
   for (int i = 0; i < smoothingSteps; ++i) field.meanCurvatureStep();
   field.redistance(kRedistanceIterations);
   field.offset(float(erosionOf(p)));
@@ -221,19 +227,15 @@ FloatGrid::Ptr smoothAndErode(NarrowBand& field, const Parameters& p, int smooth
   return gridFromBlocks(field.blocks(), p.voxel, /*trim=*/true);
 }
 
-double insideDepth(const Parameters& p) {
-  return kHalfWidthVoxels * p.voxel + std::max(erosionOf(p), 0.0) + p.voxel;
-}
-
 // `spheres`: the raw union made a distance by Eikonal iterations across the whole working band (its inside
 // values are depths under the nearest sphere, not under the union, so never below -radius; the voxels beside
-// the zero crossing are exact distances to the union and are kept), then smoothAndErode.
+// the zero crossing are exact distances to the union and are kept): one iteration per voxel of the inside's
+// depth, band + erosion + 1 voxel.
 FloatGrid::Ptr sphereLevelSet(const ParticleFrame& frame, const Parameters& p, int smoothingSteps) {
-  const double band = kHalfWidthVoxels * p.voxel, inside = insideDepth(p);
-  NarrowBand field(rawLevelSet(frame, p, band), p.voxel, float(band), float(inside));
+  BlockField raw = rawLevelSet(frame, p, kHalfWidthVoxels * p.voxel);
   Progress::checkInterrupt();
-  field.redistance(int(std::ceil(inside / p.voxel)));
-  return smoothAndErode(field, p, smoothingSteps);
+  const int iterations = int(std::ceil(kHalfWidthVoxels + std::max(erosionOf(p), 0.0) / p.voxel + 1));
+  return smoothAndErode(std::move(raw), p, smoothingSteps, iterations);
 }
 
 // The blended fields are distances only near their zero crossing, and the voxels beside it need moving too,
@@ -262,12 +264,11 @@ FloatGrid::Ptr blendedLevelSet(const ParticleFrame& frame, const Parameters& p, 
       blocks.origins.emplace_back(o.x(), o.y(), o.z());
       blocks.values.insert(blocks.values.end(), leaf->buffer().data(), leaf->buffer().data() + kBlockVoxels);
     }
-    NarrowBand field(std::move(blocks), p.voxel, float(kHalfWidthVoxels * p.voxel), float(insideDepth(p)));
-    return smoothAndErode(field, p, smoothingSteps);
+    return smoothAndErode(std::move(blocks), p, smoothingSteps, /*firstIterations=*/0);
   }
   // Anisotropic: 3 Eikonal iterations after each smoothing step (with one, the dilation below lost the block
-  // 9% more), then the dilation in CFL steps, which grow the outer band as the surface moves out.
-  filter.setNormCount(kRenormalise);
+  // 9% more; kRenormalise is still set), then the dilation in CFL steps, which grow the outer band as the
+  // surface moves out.
   for (int i = 0; i < smoothingSteps; ++i) filter.meanCurvature();
   filter.offset(float(erosionOf(p)));
   return grid;
@@ -290,7 +291,8 @@ FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
     throw RunError("surface: particle_radius " + std::to_string(p.radius) + " is under 1.5 voxels of " +
                    std::to_string(p.voxel) + "; the particles' spheres would be lost");
   if (const long far = farParticle(frame, p.voxel); far >= 0)
-    throw RunError("surface: particle " + std::to_string(far) + " lies more than 2^22 voxels from the origin");
+    throw RunError("surface: particle " + std::to_string(far) +
+                   " lies more than 2^22 voxels from the origin");
   const int steps = scene.surface.smoothing_steps;
   FloatGrid::Ptr grid =
       p.method == "spheres" ? sphereLevelSet(frame, p, steps) : blendedLevelSet(frame, p, steps);
@@ -457,7 +459,8 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
         "no particle frame in " + std::to_string(range.first) + ":" + std::to_string(range.last));
   if (resume) {
     const auto done = [&](int f) {
-      std::vector<fs::path> outputs = {framePath(dir, "surface", f, "vdb"), framePath(dir, "surface", f, "ply")};
+      std::vector<fs::path> outputs = {framePath(dir, "surface", f, "vdb"),
+                                       framePath(dir, "surface", f, "ply")};
       if (scene.surface.write_obj) outputs.push_back(framePath(dir, "surface", f, "obj"));
       return isUpToDate(outputs, {framePath(dir, "particles", f, "ply"), dir / "scene.json"});
     };

@@ -42,8 +42,8 @@ SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const 
 // The stage: for every dir/particles/frame_NNNNN.ply within range, writes dir/surface/frame_NNNNN.vdb and
 // dir/surface/frame_NNNNN.ply, frames in parallel (parallelFor, one frame a chunk: the same bytes at any
 // thread count). Reports progress per frame ("surface") and checks for Ctrl-C between frames. Throws
-// InputError naming dir if there is no particle frame (in range). With `resume`, a frame whose files are up to date (isUpToDate against its particle frame
-// and dir/scene.json) is left as it is.
+// InputError naming dir if there is no particle frame (in range). With `resume`, a frame whose files are up
+// to date (isUpToDate against its particle frame and dir/scene.json) is left as it is.
 void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress,
                    bool resume = false);
 
