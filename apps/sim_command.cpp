@@ -35,6 +35,10 @@ void checkResumable(const fs::path& previous, const std::string& previousJson, c
 }  // namespace
 
 void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const CommonOptions& options) {
+  // The colliders' files are read (and refused if bad) before anything is written.
+  const std::shared_ptr<const ColliderShapes> shapes = buildColliderShapes(scene);
+  for (const ColliderShape& shape : *shapes)
+    if (!shape.note.empty()) say(options, "sim: " + shape.note);
   const std::string json = sceneToJson(scene);
   std::error_code error;
   const bool existing = fs::exists(dir / "scene.json", error);
@@ -52,7 +56,10 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   if (!existing || previous != json)
     writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << json; });
   TerminalProgress progress(!options.quiet);
-  const SimulationSummary summary = simulate(scene, dir, resume, progress);
+  const SimulationSummary summary = simulate(scene, shapes, dir, resume, progress);
+  if (summary.removedParticles > 0)
+    say(options, "sim: removed " + std::to_string(summary.removedParticles) +
+                     " fluid particles placed inside colliders");
   char line[256];
   std::snprintf(line, sizeof line, "sim: %zu particles, frames %d-%d in %.1f s -> %s/particles",
                 summary.particles, summary.firstFrame, summary.lastFrame, summary.wallSeconds,

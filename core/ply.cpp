@@ -300,14 +300,21 @@ TriangleMesh readMeshPly(const fs::path& path) {
     throw InputError(where, "element face", "expected a single vertex_indices list");
   const PlyProperty& list = faces->properties[0];
   const char* p = file.data[faceIndex].data();
+  const char* end = p + file.data[faceIndex].size();
   const int countSize = typeSize(list.countType), itemSize = typeSize(list.type);
   for (size_t f = 0; f < faces->count; ++f) {
-    const size_t items = static_cast<size_t>(readScalar(p, list.countType));
+    if (end - p < countSize) throw InputError(where, "face " + std::to_string(f), "the file ends inside the faces");
+    const double count = readScalar(p, list.countType);
     p += countSize;
+    if (!(count >= 0 && count <= double(end - p) / itemSize))
+      throw InputError(where, "face " + std::to_string(f), "vertex count out of range");
+    const size_t items = static_cast<size_t>(count);
     std::vector<uint32_t> polygon(items);
     for (size_t k = 0; k < items; ++k, p += itemSize) {
-      polygon[k] = static_cast<uint32_t>(readScalar(p, list.type));
-      if (polygon[k] >= n) throw InputError(where, "face " + std::to_string(f), "vertex index out of range");
+      const double index = readScalar(p, list.type);  // checked before the cast: a float may hold anything
+      if (!(index >= 0 && index < double(n)))
+        throw InputError(where, "face " + std::to_string(f), "vertex index out of range");
+      polygon[k] = static_cast<uint32_t>(index);
     }
     for (size_t k = 1; k + 1 < items; ++k) mesh.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
   }

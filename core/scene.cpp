@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
 #include <iomanip>
 #include <nlohmann/json.hpp>
@@ -101,6 +102,19 @@ class JsonReader : public SceneVisitor {
     }
   }
 
+  void reals(const char* key, std::vector<double>& values, const FieldInfo& info) override {
+    if (const json* j = find(key, info)) {
+      if (!j->is_array() || j->empty() || j->size() > 3)
+        fail(key, "expected an array of 1 to 3 numbers, got " + describe(*j));
+      values.clear();
+      for (const json& item : *j) {
+        if (!item.is_number()) fail(key, "expected numbers, got " + describe(*j));
+        values.push_back(item.get<double>());
+        checkRange(key, values.back(), info);
+      }
+    }
+  }
+
   void group(const char* key, const FieldInfo& info, const std::function<void()>& body) override {
     const json* j = find(key, info);
     if (!j) return;
@@ -194,6 +208,9 @@ class JsonWriter : public SceneVisitor {
     for (int k = 0; k < (always3 ? 3 : dimensions_); ++k) array.push_back(value[k]);
     (*stack_.back())[key] = array;
   }
+  void reals(const char* key, std::vector<double>& values, const FieldInfo&) override {
+    if (!values.empty()) (*stack_.back())[key] = values;
+  }
   void group(const char* key, const FieldInfo&, const std::function<void()>& body) override {
     json& child = (*stack_.back())[key] = json::object();
     stack_.push_back(&child);
@@ -240,6 +257,9 @@ class KeyTable : public SceneVisitor {
   void vector(const char* key, Eigen::Vector3d& value, const FieldInfo& info, bool always3) override {
     std::string text = "[" + formatNumber(value[0]) + ", " + formatNumber(value[1]) + ", " + formatNumber(value[2]) + "]";
     row(key, always3 ? "3-vector" : "vector", info.required ? "" : text, info);
+  }
+  void reals(const char* key, std::vector<double>&, const FieldInfo& info) override {
+    row(key, "numbers", "", info);
   }
   void group(const char* key, const FieldInfo& info, const std::function<void()>& body) override {
     row(key, "object", "", info);
@@ -321,6 +341,59 @@ void applyOverride(json& root, const std::string& assignment, std::set<std::stri
   overridden.insert(normalisedPath(parts));
 }
 
+bool isPlainName(const std::string& name) {
+  if (name.empty() || name.front() == '.') return false;
+  for (char c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') return false;
+  return true;
+}
+
+void validateRotation(const Rotation& r, int dimensions, const std::string& where, const std::string& key) {
+  if (!(r.axis.norm() > 0)) throw InputError(where, key + ".axis", "must not be the zero vector");
+  if (dimensions == 2 && r.degrees != 0 && (std::abs(r.axis.x()) > 0 || std::abs(r.axis.y()) > 0))
+    throw InputError(where, key + ".axis", "in 2D a rotation is about z: leave the axis out or make it [0, 0, 1]");
+}
+
+// What can be checked of the colliders without reading their files (geometry/collider_shape.cpp checks those).
+void validateColliders(Scene& s, const std::string& where) {
+  std::set<std::string> names;
+  for (size_t i = 0; i < s.colliders.size(); ++i) {
+    ColliderSettings& c = s.colliders[i];
+    const std::string key = "colliders[" + std::to_string(i) + "]";
+    if (c.name.empty()) c.name = "collider" + std::to_string(i);
+    if (!isPlainName(c.name))
+      throw InputError(where, key + ".name", "must be letters, digits, '-', '_' or '.', not starting with '.'");
+    if (!names.insert(c.name).second) throw InputError(where, key + ".name", "'" + c.name + "' is used twice");
+    validateRotation(c.rotation, s.dimensions, where, key + ".rotation");
+    if (c.shape == "box") {
+      if (c.size.size() != size_t(s.dimensions))
+        throw InputError(where, key + ".size", "a box needs its full extents, " + std::to_string(s.dimensions) +
+                                                   " numbers");
+    } else if (c.shape == "heightfield") {
+      if (c.size.size() != 2) throw InputError(where, key + ".size", "a heightfield needs its [x, z] extents");
+    } else if (!c.size.empty()) {
+      throw InputError(where, key + ".size", "only a box or a heightfield has a size");
+    }
+    for (double extent : c.size)
+      if (!(extent > 0)) throw InputError(where, key + ".size", "extents must be > 0");
+    if ((c.shape == "heightfield" || c.shape == "mesh") && c.file.empty())
+      throw InputError(where, key + ".file", "a " + c.shape + " needs a file");
+    if (c.shape != "heightfield" && c.shape != "mesh" && !c.file.empty())
+      throw InputError(where, key + ".file", "only a heightfield or a mesh reads a file");
+    if (c.shape == "plane") {
+      if (!(c.normal.norm() > 0)) throw InputError(where, key + ".normal", "must not be the zero vector");
+      if (c.container) throw InputError(where, key + ".container", "a plane cannot hold fluid; turn its normal");
+    }
+    if (c.thickness == 0) c.thickness = s.particle_spacing;
+    for (size_t k = 0; k < c.motion.size(); ++k) {
+      const std::string frameKey = key + ".motion[" + std::to_string(k) + "]";
+      validateRotation(c.motion[k].rotation, s.dimensions, where, frameKey + ".rotation");
+      if (k > 0 && c.motion[k].time < c.motion[k - 1].time)
+        throw InputError(where, frameKey + ".time", "keyframes must be in time order");
+    }
+  }
+}
+
 void validate(Scene& s, const std::string& where) {
   const int d = s.dimensions;
   for (int k = 0; k < d; ++k)
@@ -367,6 +440,8 @@ void validate(Scene& s, const std::string& where) {
   for (size_t i = 1; i < s.attractor.keyframes.size(); ++i)
     if (s.attractor.keyframes[i].time < s.attractor.keyframes[i - 1].time)
       throw InputError(where, "attractor.keyframes[" + std::to_string(i) + "].time", "keyframes must be in time order");
+
+  validateColliders(s, where);
 
   SurfaceSettings& surface = s.surface;
   if (surface.particle_radius == 0) surface.particle_radius = spacing;
@@ -437,7 +512,13 @@ Scene parseScene(const std::string& text, const std::string& where, const std::v
       const auto colon = message.find("] ");
       throw InputError(where, "byte " + std::to_string(e.byte),
                        "invalid JSON" + (colon == std::string::npos ? "" : " (" + message.substr(colon + 2) + ")"));
+    } catch (const json::exception& e) {
+      // For example a number too large for a double (1e400): the library names no key, only the number.
+      std::string message = e.what();
+      const auto colon = message.find("] ");
+      throw InputError(where, "invalid JSON" + (colon == std::string::npos ? "" : " (" + message.substr(colon + 2) + ")"));
     }
+    throw InputError(where, "invalid JSON");
   }
   std::set<std::string> overridden;
   if (root.is_object())
@@ -447,11 +528,17 @@ Scene parseScene(const std::string& text, const std::string& where, const std::v
   visitScene(scene, reader);
   reader.finish();
   validate(scene, where);
+  scene.source = where;
   return scene;
 }
 
 Scene loadScene(const fs::path& path, const std::vector<std::string>& overrides) {
-  return parseScene(readTextFile(path), path.string(), overrides);
+  Scene scene = parseScene(readTextFile(path), path.string(), overrides);
+  // Collider files are named relative to the scene file; the resolved scene (scene.json) holds them absolute.
+  for (ColliderSettings& c : scene.colliders)
+    if (!c.file.empty() && fs::path(c.file).is_relative())
+      c.file = fs::absolute(path.parent_path() / c.file).lexically_normal().string();
+  return scene;
 }
 
 std::string sceneToJson(const Scene& scene) {

@@ -61,6 +61,40 @@ struct AttractorSettings {
   std::vector<AttractorKeyframe> keyframes;
 };
 
+// A rotation about an axis through the shape's position (in 2D always about z).
+struct Rotation {
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  double degrees = 0;
+};
+
+struct ColliderKeyframe {
+  double time = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Rotation rotation;
+};
+
+// An obstacle or a container the fluid meets (geometry/collider_shape.h builds it, sim/colliders.h simulates
+// it). Shapes are given in their own frame (centred on `position`, capsule and cylinder along local y) and
+// placed by scale, then rotation, then translation.
+struct ColliderSettings {
+  std::string name;            // empty in the file: "collider<i>" (resolved)
+  std::string shape = "box";   // plane, box, sphere, capsule, cylinder, heightfield, mesh
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Rotation rotation;
+  double scale = 1;
+  int container = 0;           // 1: the fluid stays inside the shape
+  std::vector<double> size;    // box: full extents (a vector); heightfield: [x, z] extents
+  double radius = 0.1;
+  double height = 0.2;         // capsule, cylinder: length along local y; heightfield: height of white
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitY();  // plane
+  std::string file;            // heightfield PNG or mesh OBJ/PLY, relative to the scene file (resolved absolute)
+  double thickness = 0;        // open meshes: shell thickness; 0 means particle_spacing (resolved)
+  std::vector<ColliderKeyframe> motion;
+  double friction = 0;
+  Eigen::Vector3d color = Eigen::Vector3d(0.62, 0.6, 0.56);
+  int visible = 1;
+};
+
 struct OutputSettings {
   double fps = 30;
   int frames = 90;
@@ -98,6 +132,7 @@ struct RenderSettings {
   Eigen::Vector3d sky_zenith = Eigen::Vector3d(0.32, 0.5, 0.82);
   Eigen::Vector3d sky_horizon = Eigen::Vector3d(0.78, 0.84, 0.9);
   double exposure = 1.0;
+  std::string tank = "edges";  // how the tank is drawn: edges, glass or none
 };
 
 struct Scene {
@@ -108,10 +143,14 @@ struct Scene {
   std::vector<FluidBlock> fluids;
   Eigen::Vector3d gravity = Eigen::Vector3d(0, -9.81, 0);
   AttractorSettings attractor;
+  std::vector<ColliderSettings> colliders;
   SolverSettings solver;
   OutputSettings output;
   SurfaceSettings surface;
   RenderSettings render;
+
+  // The scene file it was read from (not a key): collider files are found beside it, errors name it.
+  std::string source;
 
   // Particles the fluid boxes hold on the lattice of particle_spacing.
   size_t particleCount() const;

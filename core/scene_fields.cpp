@@ -36,6 +36,49 @@ void visitBox(SceneVisitor& v, const char* key, Box& box, const char* what) {
   });
 }
 
+void visitRotation(SceneVisitor& v, Rotation& r) {
+  v.group("rotation", info("rotation about an axis through the position; in 2D always about z"), [&] {
+    v.vector("axis", r.axis, info("rotation axis (any length but 0; 3 components also in 2D)"), true);
+    v.real("degrees", r.degrees, info("angle, counter-clockwise about the axis", "degrees"));
+  });
+}
+
+void visitCollider(SceneVisitor& v, ColliderSettings& c) {
+  v.text("name", c.name, info("a name for colliders.csv and the output meshes (letters, digits, -, _); empty: "
+                              "collider<i>"));
+  v.choice("shape", c.shape, {"plane", "box", "sphere", "capsule", "cylinder", "heightfield", "mesh"},
+           required("plane (a half-space), box, sphere, capsule and cylinder (along local y), heightfield (a "
+                    "greyscale PNG; the fluid stays above), mesh (OBJ or PLY)"));
+  v.vector("position", c.position,
+           info("the shape's centre; a point on a plane; the centre of a heightfield's base (black)", "m"));
+  visitRotation(v, c.rotation);
+  v.real("scale", c.scale, positive("uniform scale of the shape about its position"));
+  v.integer("container", c.container,
+            atLeast(0, "1: the fluid is held inside the shape (a bowl, a glass) instead of kept out", "", 1));
+  v.reals("size", c.size, info("box: full extents (a vector); heightfield: [x, z] extents", "m"));
+  v.real("radius", c.radius, positive("sphere, capsule and cylinder radius", "m"));
+  v.real("height", c.height,
+         positive("capsule and cylinder: length along local y (a capsule's without its caps); heightfield: the "
+                  "height of white",
+                  "m"));
+  v.vector("normal", c.normal, info("plane: the normal, pointing into the fluid (any length but 0)"));
+  v.text("file", c.file, info("heightfield: a PNG (8 or 16 bit grey); mesh: an OBJ or PLY; relative to the scene file"));
+  v.real("thickness", c.thickness,
+         atLeast(0, "mesh: the shell thickness given to an open or non-manifold mesh; 0 means particle_spacing", "m"));
+  v.list(
+      "motion", info("keyframes of position and rotation, linearly interpolated (held before the first and after "
+                     "the last); empty: the collider stands still"),
+      [&] { return c.motion.size(); }, [&](size_t n) { c.motion.resize(n); },
+      [&](size_t i) {
+        v.real("time", c.motion[i].time, atLeast(0, "time of the keyframe", "s"));
+        v.vector("position", c.motion[i].position, required("position at that time", "m"));
+        visitRotation(v, c.motion[i].rotation);
+      });
+  v.real("friction", c.friction, atLeast(0, "0: free slip; 1: no slip", "", 1));
+  v.vector("color", c.color, atLeast(0, "linear RGB albedo in the renders", "", 1), true);
+  v.integer("visible", c.visible, atLeast(0, "0: simulated but not drawn", "", 1));
+}
+
 }  // namespace
 
 void visitScene(Scene& s, SceneVisitor& v) {
@@ -70,6 +113,11 @@ void visitScene(Scene& s, SceneVisitor& v) {
           v.vector("position", s.attractor.keyframes[i].position, required("position at that time", "m"));
         });
   });
+
+  v.list(
+      "colliders", info("obstacles and containers the fluid meets (the tank's walls are always there)"),
+      [&] { return s.colliders.size(); }, [&](size_t n) { s.colliders.resize(n); },
+      [&](size_t i) { visitCollider(v, s.colliders[i]); });
 
   v.group("solver", info("the simulator"), [&] {
     v.choice("method", s.solver.method, {"pbf", "wcsph"},
@@ -178,6 +226,9 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.vector("sky_horizon", s.render.sky_horizon,
              atLeast(0, "linear RGB radiance of the sky at the horizon", "", 1000), true);
     v.real("exposure", s.render.exposure, positive("scale on linear light before the tone map"));
+    v.choice("tank", s.render.tank, {"edges", "glass", "none"},
+             info("how the tank is drawn: its edges as thin dark bars, its walls as clear glass (path tracer; the "
+                  "preview draws edges), or not at all"));
   });
 }
 

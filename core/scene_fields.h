@@ -30,6 +30,8 @@ class SceneVisitor {
   virtual void real(const char* key, double& value, const FieldInfo& info) = 0;
   // A vector of `dimensions` components (the scene's, or 3 when `always3`).
   virtual void vector(const char* key, Eigen::Vector3d& value, const FieldInfo& info, bool always3 = false) = 0;
+  // An array of 1 to 3 numbers whose length depends on the context (a box's size, a heightfield's extents).
+  virtual void reals(const char* key, std::vector<double>& values, const FieldInfo& info) = 0;
   virtual void group(const char* key, const FieldInfo& info, const std::function<void()>& body) = 0;
   // A list of objects: size(), resize(n), and visitItem(i) which visits item i's fields.
   virtual void list(const char* key, const FieldInfo& info, const std::function<size_t()>& size,

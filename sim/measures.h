@@ -24,10 +24,10 @@ struct FluidMeasures {
 };
 
 // The measures at positions x with neighbour lists of (nearly) those positions; weight(r2) is the density
-// kernel W as a function of the squared distance.
-template <int Dim, typename Weight>
+// kernel W as a function of the squared distance; walls.add(p, weight, gradient) adds the boundary's share.
+template <int Dim, typename Walls, typename Weight>
 FluidMeasures measureDensityAndEnergy(const std::vector<Vec<Dim>>& x, const std::vector<Vec<Dim>>& v,
-                                      const NeighborLists& neighbors, const TankWalls<Dim>& walls, float mass,
+                                      const NeighborLists& neighbors, const Walls& walls, float mass,
                                       float restDensity, Weight weight) {
   struct Sums {
     double errorSum = 0, errorMax = 0, energy = 0;

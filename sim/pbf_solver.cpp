@@ -27,7 +27,7 @@ double millisecondsSince(Clock::time_point start) {
 }  // namespace
 
 template <int Dim>
-PbfSolver<Dim>::PbfSolver(const Scene& scene)
+PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes)
     : kernels_(static_cast<float>(scene.solver.kernel_radius)),
       attractor_(scene.attractor),
       // Cells of half the kernel radius: searching 5 cells a side reads fewer candidates than 3 of the radius.
@@ -37,6 +37,7 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene)
              static_cast<float>(scene.solver.kernel_radius),
              [&](const VecD& r) { return kernels_.poly6(r.squaredNorm()); },
              [&](const VecD& r) { return kernels_.spikyGradient(r, r.norm()); }) {
+  if (!scene.colliders.empty()) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_.flatWall());
   substeps_ = scene.solver.substeps;
   const SolverSettings& s = scene.solver;
   const float spacing = static_cast<float>(scene.particle_spacing);
@@ -72,6 +73,7 @@ void PbfSolver<Dim>::setParticles(const ParticleFrame& frame) {
   const size_t n = frame.size();
   p_.resize(n);
   lambda_.assign(n, 0.0f);
+  colliders_.resetSlots(n);
   if (vorticityEpsilon_ > 0) (Dim == 3 ? omega3_.resize(n) : omega2_.resize(n));
 }
 
@@ -82,10 +84,13 @@ void PbfSolver<Dim>::getParticles(ParticleFrame& frame) const {
 
 template <int Dim>
 long PbfSolver<Dim>::step(float dt, double time) {
+  stepDt_ = dt;
+  if (!colliders_.empty()) colliders_.beginStep(time, dt);
   predictPositions(dt, time);
   findNeighbors();
   solveDensityConstraints();
   updateVelocities(dt);
+  if (colliders_.hasFriction()) applyFriction();
   if (vorticityEpsilon_ > 0) applyVorticityConfinement(dt);
   if (xsphC_ > 0) applyXsphViscosity();
   x_.swap(p_);  // line 23: x_i = x*_i
@@ -103,8 +108,26 @@ void PbfSolver<Dim>::predictPositions(float dt, double time) {
       v_[i] += dt * gravity_;
       if (attract) v_[i] += dt * attractor_.acceleration(x_[i], attractorAt);
       p_[i] = x_[i] + dt * v_[i];
+      if (!colliders_.empty()) collide(i, x_[i]);
       walls_.clamp(p_[i]);
     }
+  });
+}
+
+// The colliders' collision response for the move of p*_i from `from`; each push is an impulse m delta / dt
+// given to the particle (v = (x* - x) / dt at the end of the step).
+template <int Dim>
+void PbfSolver<Dim>::collide(size_t i, const VecD& from) {
+  colliders_.project(from, p_[i], [&](size_t c, const VecD& delta) {
+    colliders_.addImpulse(i, c, (mass_ / stepDt_) * delta, p_[i]);
+  });
+}
+
+// Friction at the colliders, on the velocities of line 21.
+template <int Dim>
+void PbfSolver<Dim>::applyFriction() {
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) colliders_.applyFriction(i, p_[i], v_[i], mass_);
   });
 }
 
@@ -175,6 +198,13 @@ double PbfSolver<Dim>::computeLambdas() {
       VecD wallGradient = VecD::Zero();
       walls_.add(p_[i], weight, wallGradient);
       gradientI += massOverRho_ * wallGradient;
+      if (!colliders_.empty()) {
+        float colliderWeight = 0;
+        VecD colliderGradient = VecD::Zero();
+        colliders_.add(pi, colliderWeight, colliderGradient);
+        weight += colliderWeight;
+        gradientI += massOverRho_ * colliderGradient;
+      }
       const float constraint = std::max(mass_ * weight / restDensity_ - 1.0f, 0.0f);
       lambda_[i] = -constraint / (gradientSquaredSum + gradientI.squaredNorm() + epsilon_);
       errorSum += constraint;
@@ -221,14 +251,35 @@ void PbfSolver<Dim>::applyPositionCorrections() {
       walls_.add(p_[i], unusedWeight, wallGradient);
       delta += lambda_[i] * wallGradient;
       scratch_[i] = massOverRho_ * delta;
+      // The colliders likewise; each one's share is an impulse it gives the particle.
+      if (!colliders_.empty() && lambdaI != 0.0f) scratch_[i] += colliderCorrection(i, pi, lambdaI);
     }
   });
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
+      const VecD before = p_[i];
       p_[i] += scratch_[i];
+      if (!colliders_.empty()) collide(i, before);
       walls_.clamp(p_[i]);
     }
   });
+}
+
+// The colliders' share of eq. 12 for particle i at p with lambda_i: (m / rho_0) lambda_i sum_c grad W_c, each
+// collider's part an impulse it gives the particle. Kept out of the loop above, which stays as it was for a
+// scene without colliders (same instructions, same bytes).
+template <int Dim>
+typename PbfSolver<Dim>::VecD PbfSolver<Dim>::colliderCorrection(size_t i, const VecD& p, float lambda) {
+  VecD delta = VecD::Zero();
+  colliders_.forEachNear(p, [&](size_t c, float d, const VecD& n) {
+    float unused;
+    VecD gradient;
+    colliders_.wallTerms(d, n, unused, gradient);
+    const VecD move = (massOverRho_ * lambda) * gradient;
+    delta += move;
+    colliders_.addImpulse(i, c, (mass_ / stepDt_) * move, p);
+  });
+  return delta;
 }
 
 // Line 21: v_i = (x*_i - x_i) / dt.
@@ -326,7 +377,7 @@ FluidMeasures PbfSolver<Dim>::measure() {
     p_ = x_;  // before the first step: neighbours of the current positions
     findNeighbors();
   }
-  return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, walls_, mass_, restDensity_,
+  return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, Boundary<Dim>{walls_, colliders_}, mass_, restDensity_,
                                       [&](float r2) { return kernels_.poly6(r2); });
 }
 
@@ -336,7 +387,7 @@ size_t PbfSolver<Dim>::memoryBytes() const {
   bytes += (id_.capacity() + scratchIds_.capacity()) * sizeof(uint32_t);
   bytes += (lambda_.capacity() + omega2_.capacity()) * sizeof(float);
   for (const auto& factors : pairGradientFactors_) bytes += factors.capacity() * sizeof(float);
-  return bytes + grid_.memoryBytes() + neighbors_.memoryBytes();
+  return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes();
 }
 
 template class PbfSolver<2>;

@@ -19,6 +19,7 @@
 #include "core/ply.h"
 #include "core/scene.h"
 #include "sim/attractor.h"
+#include "sim/colliders.h"
 #include "sim/kernels.h"
 #include "sim/measures.h"
 #include "sim/neighbor_grid.h"
@@ -31,7 +32,8 @@ class PbfSolver {
  public:
   using VecD = Vec<Dim>;
 
-  explicit PbfSolver(const Scene& scene);
+  // `shapes`: the scene's collider shapes, built once by the caller; null builds them from the scene.
+  explicit PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes = nullptr);
 
   void setParticles(const ParticleFrame& frame);
   void getParticles(ParticleFrame& frame) const;
@@ -53,6 +55,10 @@ class PbfSolver {
   uint32_t particleId(size_t i) const { return id_[i]; }
   float particleMass() const { return mass_; }
   const std::vector<VecD>& positions() const { return x_; }
+  const std::vector<VecD>& velocities() const { return v_; }
+  // Each collider's mean force and torque from the fluid since the last call, over `duration` seconds.
+  std::vector<Wrench> takeColliderWrenches(double duration) { return colliders_.takeFrameWrenches(duration); }
+  const Colliders<Dim>& colliders() const { return colliders_; }
   // Bytes held by every particle channel, the grid, the neighbour lists and the pair factors (capacities).
   size_t memoryBytes() const;
 
@@ -63,6 +69,9 @@ class PbfSolver {
   double computeLambdas();  // returns the average density error before this iteration's correction
   void applyPositionCorrections();
   void updateVelocities(float dt);
+  void collide(size_t i, const VecD& from);
+  VecD colliderCorrection(size_t i, const VecD& p, float lambda);
+  void applyFriction();
   void applyVorticityConfinement(float dt);
   void applyXsphViscosity();
   // The offset p_i - p_j used for a pair closer than coincidentLength_ (see the .cpp).
@@ -94,6 +103,8 @@ class PbfSolver {
   std::vector<uint32_t> scratchIds_;
   NeighborGrid<Dim> grid_;
   TankWalls<Dim> walls_;
+  Colliders<Dim> colliders_;  // empty without colliders
+  float stepDt_ = 0;          // the current step (turns collider displacements into impulses)
   NeighborLists neighbors_;
   // Per neighbour pair, parallel to neighbors_: the spiky gradient factor g of Kernels::pair, computed by the
   // lambda pass and reused by the position-correction pass of the same iteration (same positions).

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "geometry/pose.h"
 #include "sim/pbf_solver.h"
 #include "sim/wcsph_solver.h"
 
@@ -22,10 +23,12 @@ std::string formatVector(const Eigen::Vector3f& v, int dimensions) {
   return out.str();
 }
 
-// Rows of stats.csv kept in memory and rewritten whole after every frame, so the file is never half a row.
-class StatsFile {
+// Rows of a per-frame table (stats.csv, colliders.csv) kept in memory and rewritten whole after every frame, so
+// the file is never half a row; on resume, the rows of the frames up to the one resumed from are kept.
+class CsvFile {
  public:
-  StatsFile(fs::path path, bool resume, int resumeFrame) : path_(std::move(path)) {
+  CsvFile(fs::path path, std::string header, bool resume, int resumeFrame)
+      : path_(std::move(path)), header_(std::move(header)) {
     if (!resume) return;
     std::ifstream in(path_);
     std::string line;
@@ -38,13 +41,14 @@ class StatsFile {
   void add(const std::string& row) {
     rows_.push_back(row);
     writeFileAtomically(path_, [&](std::ostream& out) {
-      out << statsCsvHeader() << "\n";
+      out << header_ << "\n";
       for (const std::string& r : rows_) out << r << "\n";
     });
   }
 
  private:
   fs::path path_;
+  std::string header_;
   std::vector<std::string> rows_;
 };
 
@@ -99,18 +103,91 @@ float walkWhileContiguous(const std::vector<float>& sorted, size_t start, float 
                  formatVector(state.velocity[particle], state.dimensions) + " (not finite or outside the domain)");
 }
 
+// Removes the particles closer to a collider than their radius (as placed at time 0); returns how many.
+template <int Dim>
+size_t removeParticlesInside(const Colliders<Dim>& colliders, ParticleFrame& frame) {
+  size_t kept = 0;
+  const float radius = 0.99f * colliders.particleRadius();  // a fluid box drawn against a wall keeps its layer
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const Vec<Dim> p = frame.position[i].head<Dim>();
+    bool inside = false;
+    for (size_t c = 0; c < colliders.size() && !inside; ++c) {
+      Vec<Dim> normal;
+      inside = colliders.distance(c, p, normal) < radius;
+    }
+    if (inside) continue;
+    frame.position[kept] = frame.position[i];
+    frame.velocity[kept] = frame.velocity[i];
+    frame.id[kept] = static_cast<uint32_t>(kept);
+    ++kept;
+  }
+  const size_t removed = frame.size() - kept;
+  frame.resize(kept);
+  return removed;
+}
+
+// One colliders.csv row a collider: the frame's mean force (N) and torque about the collider's position (N m).
+std::string colliderRows(const Scene& scene, int frame, const std::vector<Wrench>& wrenches) {
+  std::string rows;
+  for (size_t c = 0; c < wrenches.size(); ++c) {
+    char row[512];
+    const Wrench& w = wrenches[c];
+    std::snprintf(row, sizeof row, "%d,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g", frame, scene.colliders[c].name.c_str(),
+                  w.force.x(), w.force.y(), w.force.z(), w.torque.x(), w.torque.y(), w.torque.z());
+    rows += (rows.empty() ? "" : "\n") + std::string(row);
+  }
+  return rows;
+}
+
+// A collider's mesh placed in the world at `time`.
+TriangleMesh placedMesh(const ColliderSettings& settings, const ColliderShape& shape, double time) {
+  const Pose pose = colliderPose(settings, time);
+  TriangleMesh mesh = shape.mesh;
+  for (Eigen::Vector3f& p : mesh.positions) p = pose.toWorld(p.cast<double>()).cast<float>();
+  for (Eigen::Vector3f& n : mesh.normals) n = (pose.rotation * n.cast<double>()).cast<float>();
+  return mesh;
+}
+
+// colliders/<name>.ply: each collider's mesh in the world as it stands at time 0, so that the later stages and
+// Blender never reload the scene's own files. A new run starts the folder afresh.
+void writeColliderMeshes(const Scene& scene, const ColliderShapes& shapes, const fs::path& dir, bool resume) {
+  const fs::path folder = dir / "colliders";
+  std::error_code error;
+  if (!resume) fs::remove_all(folder, error);
+  fs::create_directories(folder);
+  for (size_t c = 0; c < shapes.size(); ++c) {
+    writeMeshPly(folder / (scene.colliders[c].name + ".ply"), placedMesh(scene.colliders[c], shapes[c], 0.0));
+    if (isMoving(scene.colliders[c])) {
+      fs::create_directories(folder / scene.colliders[c].name);
+      const fs::path first = framePath(folder, scene.colliders[c].name, 0, "ply");
+      if (!fs::exists(first, error)) writeMeshPly(first, placedMesh(scene.colliders[c], shapes[c], 0.0));
+    }
+  }
+}
+
+// colliders/<name>/frame_NNNNN.ply: a moving collider's mesh at each frame.
+void writeMovingColliderMeshes(const Scene& scene, const ColliderShapes& shapes, const fs::path& dir, int frame) {
+  for (size_t c = 0; c < shapes.size(); ++c)
+    if (isMoving(scene.colliders[c]))
+      writeMeshPly(framePath(dir / "colliders", scene.colliders[c].name, frame, "ply"),
+                   placedMesh(scene.colliders[c], shapes[c], frame / scene.output.fps));
+}
+
 // The frame loop, for either solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
 // otherwise each step is the largest stable one (stableTimeStep) shortened so the steps left end exactly on the
 // frame: dt = remaining / ceil(remaining / stable).
 template <int Dim, typename Solver>
-SimulationSummary run(const Scene& scene, const fs::path& dir, bool resume, Progress& progress) {
+SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
+                      bool resume, Progress& progress) {
   const auto runStart = std::chrono::steady_clock::now();
   const fs::path particleDir = dir / "particles";
   removeStaleFiles(particleDir, !resume);
   fs::create_directories(particleDir);
 
-  Solver solver(scene);
+  Solver solver(scene, shapes);
   SimulationSummary summary;
+  const bool colliding = !scene.colliders.empty();
+  if (colliding) writeColliderMeshes(scene, *shapes, dir, resume);
   const std::vector<int> existing = resume ? listFrames(dir, "particles", "ply") : std::vector<int>{};
   if (!existing.empty()) {
     summary.firstFrame = std::min(existing.back(), scene.output.frames);
@@ -119,10 +196,19 @@ SimulationSummary run(const Scene& scene, const fs::path& dir, bool resume, Prog
     if (frame.dimensions != Dim) throw InputError(path.string(), "dimensions", "differs from the scene's");
     solver.setParticles(frame);
   } else {
-    solver.setParticles(initialParticles(scene));
+    ParticleFrame initial = initialParticles(scene);
+    if (colliding) {
+      summary.removedParticles = removeParticlesInside(solver.colliders(), initial);
+      if (initial.size() == 0)
+        throw InputError(scene.source, "colliders", "every fluid particle lies inside a collider");
+    }
+    solver.setParticles(initial);
   }
   const bool fresh = existing.empty();
-  StatsFile stats(dir / "stats.csv", !fresh, summary.firstFrame);
+  CsvFile stats(dir / "stats.csv", statsCsvHeader(), !fresh, summary.firstFrame);
+  std::unique_ptr<CsvFile> colliderTable;
+  if (colliding)
+    colliderTable = std::make_unique<CsvFile>(dir / "colliders.csv", collidersCsvHeader(), !fresh, summary.firstFrame);
   ParticleFrame frame;
   if (fresh) {
     solver.getParticles(frame);
@@ -173,6 +259,10 @@ SimulationSummary run(const Scene& scene, const fs::path& dir, bool resume, Prog
     // are the ones kept, so stats.csv never misses a frame that is on disk.
     stats.add(statsRow(f, f * frameDuration, solver.size(), steps, double(iterations) / steps, measures, seconds,
                        solver.phaseTimes(), smallestStep, solver.maxPressure(), measureDamBreak(scene, frame)));
+    if (colliding) {
+      colliderTable->add(colliderRows(scene, f, solver.takeColliderWrenches(frameDuration)));
+      writeMovingColliderMeshes(scene, *shapes, dir, f);
+    }
     writeParticlePly(framePath(dir, "particles", f, "ply"), frame);
     progress.advance();
   }
@@ -245,10 +335,19 @@ ParticleFrame initialParticles(const Scene& scene) {
 }
 
 SimulationSummary simulate(const Scene& scene, const fs::path& dir, bool resume, Progress& progress) {
+  return simulate(scene, buildColliderShapes(scene), dir, resume, progress);
+}
+
+SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
+                           bool resume, Progress& progress) {
   const bool wcsph = scene.solver.method == "wcsph";
   if (scene.dimensions == 2)
-    return wcsph ? run<2, WcsphSolver<2>>(scene, dir, resume, progress) : run<2, PbfSolver<2>>(scene, dir, resume, progress);
-  return wcsph ? run<3, WcsphSolver<3>>(scene, dir, resume, progress) : run<3, PbfSolver<3>>(scene, dir, resume, progress);
+    return wcsph ? run<2, WcsphSolver<2>>(scene, shapes, dir, resume, progress)
+                 : run<2, PbfSolver<2>>(scene, shapes, dir, resume, progress);
+  return wcsph ? run<3, WcsphSolver<3>>(scene, shapes, dir, resume, progress)
+               : run<3, PbfSolver<3>>(scene, shapes, dir, resume, progress);
 }
+
+const char* collidersCsvHeader() { return "frame,collider,fx,fy,fz,tx,ty,tz"; }
 
 }  // namespace surge

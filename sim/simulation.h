@@ -5,6 +5,7 @@
 #include "core/ply.h"
 #include "core/progress.h"
 #include "core/scene.h"
+#include "sim/colliders.h"
 
 namespace surge {
 
@@ -15,6 +16,7 @@ struct SimulationSummary {
   int firstFrame = 0;  // the frame the run started from (0, or the frame it resumed from)
   int lastFrame = 0;
   size_t particles = 0;
+  size_t removedParticles = 0;  // fluid placed inside colliders, removed at set-up
   double wallSeconds = 0;
 };
 
@@ -22,7 +24,12 @@ struct SimulationSummary {
 // With resume, continues from the last complete frame in dir (frames are written whole or not at all), and
 // ends byte-identical to an uninterrupted run. Throws RunError naming frame, substep and particle if the
 // simulation diverges (earlier frames stay intact), Interrupted on Ctrl-C.
+// Also writes colliders.csv and the colliders' meshes (colliders/<name>.ply, and colliders/<name>/frame_NNNNN.ply
+// for a moving one) when the scene has colliders. `shapes` are the scene's built collider shapes (built here if
+// not given; building them first lets a caller refuse bad collider files before writing anything).
 SimulationSummary simulate(const Scene& scene, const fs::path& dir, bool resume, Progress& progress);
+SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
+                           bool resume, Progress& progress);
 
 // The dam-break measures of stats.csv, in metres, from one frame (deterministic: a sort of a copy).
 // The start wall is the x wall the first fluid box touches (the nearer one if it touches neither, domain.min.x if
@@ -44,7 +51,8 @@ DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame)
 // whose front_x and back_height can be compared with experiments (Martin & Moyce 1952) and across runs.
 bool isDamBreak(const Scene& scene);
 
-// The columns of stats.csv, in order.
+// The columns of stats.csv and colliders.csv, in order.
 const char* statsCsvHeader();
+const char* collidersCsvHeader();
 
 }  // namespace surge

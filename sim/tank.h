@@ -37,6 +37,26 @@ void latticeSums(float spacing, float support, Weight weight, Gradient gradient,
   *gradientSquaredSum = g;
 }
 
+// One flat wall's share at distance d from a particle: the kernel weight sum over the lattice beyond it, and the
+// magnitude of the gradient sum, which points from the particle towards the wall. Zero beyond the support; a
+// negative d reads as 0. The tank tabulates it; colliders (sim/colliders.h) use it for every shape, taking the
+// wall locally flat.
+struct FlatWallTable {
+  std::vector<float> weight, gradient;
+  float scale = 0;  // table entries per metre
+
+  void lookup(float d, float& w, float& g) const {
+    const float u = std::max(d, 0.0f) * scale;
+    const int size = static_cast<int>(weight.size()) - 1;
+    w = g = 0;
+    if (!(u < size)) return;  // also NaN
+    const int t = static_cast<int>(u);
+    const float f = u - t;
+    w = (1 - f) * weight[t] + f * weight[t + 1];
+    g = (1 - f) * gradient[t] + f * gradient[t + 1];
+  }
+};
+
 template <int Dim>
 class TankWalls {
  public:
@@ -56,14 +76,14 @@ class TankWalls {
     const auto beyond = [&](int walls, const float* d, double* g) {
       return sumBeyond(walls, d, spacing, reach, weight, gradient, g);
     };
-    weight_.assign(kTableSize + 1, 0.0f);
-    gradient_.assign(kTableSize + 1, 0.0f);
-    tableScale_ = kTableSize / support;
+    flat_.weight.assign(kTableSize + 1, 0.0f);
+    flat_.gradient.assign(kTableSize + 1, 0.0f);
+    flat_.scale = kTableSize / support;
     for (int t = 0; t <= kTableSize; ++t) {
       const float d[1] = {support * t / kTableSize};
       double g[3];
-      weight_[t] = static_cast<float>(beyond(1, d, g));
-      gradient_[t] = static_cast<float>(-g[0]);  // g[0] <= 0: towards the wall
+      flat_.weight[t] = static_cast<float>(beyond(1, d, g));
+      flat_.gradient[t] = static_cast<float>(-g[0]);  // g[0] <= 0: towards the wall
     }
     // Along an edge where two walls meet, both walls' lattices hold the quarter beyond both: tabulate that
     // quarter (distances dA, dB to the two walls) so add() can count it once.
@@ -98,12 +118,12 @@ class TankWalls {
     for (int k = 0; k < Dim; ++k)
       for (int side = 0; side < 2; ++side) {
         const float d = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
-        const float u = std::max(d, 0.0f) * tableScale_;
+        const float u = std::max(d, 0.0f) * flat_.scale;
         if (!(u < kTableSize)) continue;  // also skips NaN
         const int t = static_cast<int>(u);
         const float f = u - t;
-        weight += (1 - f) * weight_[t] + f * weight_[t + 1];
-        const float g = (1 - f) * gradient_[t] + f * gradient_[t + 1];
+        weight += (1 - f) * flat_.weight[t] + f * flat_.weight[t + 1];
+        const float g = (1 - f) * flat_.gradient[t] + f * flat_.gradient[t + 1];
         gradient[k] += side == 0 ? -g : g;  // grad_{p_i} points towards the wall
       }
     // Edges: the quarter beyond two walls was added by each; take it away once. Corners: the eighth beyond
@@ -131,6 +151,9 @@ class TankWalls {
         }
     if constexpr (Dim == 3) addCorners(p, weight, gradient);
   }
+
+  // The share of one flat wall at distance d (the table above): see FlatWallTable.
+  const FlatWallTable& flatWall() const { return flat_; }
 
   // Collision response: projects p back to a particle radius inside the tank. NaN stays NaN (comparisons with
   // NaN are false), so a diverged particle is reported rather than hidden at a wall. Returns the axes moved
@@ -231,8 +254,7 @@ class TankWalls {
     float weight = 0, gradientA = 0, gradientB = 0;  // gradients: magnitudes towards each wall
   };
   VecD domainMin_, domainMax_, clampMin_, clampMax_;
-  std::vector<float> weight_, gradient_;
-  float tableScale_ = 0;
+  FlatWallTable flat_;
   std::vector<EdgeEntry> edge_;
   float edgeScale_ = 0;
   struct CornerEntry {

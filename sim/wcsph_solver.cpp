@@ -33,7 +33,7 @@ TankWalls<Dim> makeWalls(const Scene& scene) {
 }  // namespace
 
 template <int Dim>
-WcsphSolver<Dim>::WcsphSolver(const Scene& scene)
+WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes)
     : wendland_(scene.solver.kernel == "wendland_c2"),
       verlet_(scene.solver.integrator == "velocity_verlet"),
       tait_(scene.solver.equation_of_state == "tait"),
@@ -43,6 +43,7 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene)
       grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
             static_cast<float>(0.5 * scene.solver.kernel_radius)),
       walls_(makeWalls<Dim>(scene)) {
+  if (!scene.colliders.empty()) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_.flatWall());
   const SolverSettings& s = scene.solver;
   support_ = static_cast<float>(s.kernel_radius);
   smoothingLength_ = 0.5f * support_;
@@ -76,6 +77,8 @@ void WcsphSolver<Dim>::setParticles(const ParticleFrame& frame) {
   density_.assign(n, restDensity_);
   pressure_.assign(n, 0.0f);
   if (nearStiffness_ > 0) nearPressure_.assign(n, 0.0f);
+  colliders_.resetSlots(n);
+  colliderForces_.assign(colliders_.size(), Wrench{});
   accelerationsValid_ = false;
 }
 
@@ -127,7 +130,22 @@ template <int Dim>
 void WcsphSolver<Dim>::drift(float dt) {
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
+      const VecD from = x_[i];
       x_[i] += dt * v_[i];
+      if (!colliders_.empty()) {
+        // Stopped at a collider: no velocity into it, relative to its own; the change is the collider's impulse.
+        colliders_.project(from, x_[i], [&](size_t c, const VecD& delta) {
+          const float length = delta.norm();
+          if (!(length > 0)) return;
+          const VecD n = delta / length;
+          const float approach = (v_[i] - colliders_.wallVelocity(c, x_[i])).dot(n);
+          if (approach >= 0) return;
+          const VecD change = -approach * n;
+          v_[i] += change;
+          colliders_.addImpulse(i, c, mass_ * change, x_[i]);
+        });
+        if (colliders_.hasFriction()) colliders_.applyFriction(i, x_[i], v_[i], mass_);
+      }
       const int moved = walls_.clamp(x_[i]);
       for (int k = 0; k < Dim; ++k)
         if (moved & (1 << k)) v_[i][k] = 0;  // no velocity into a wall the particle was stopped at
@@ -137,24 +155,32 @@ void WcsphSolver<Dim>::drift(float dt) {
 
 template <int Dim>
 long WcsphSolver<Dim>::step(float dt, double time) {
+  if (!colliders_.empty()) colliders_.beginStep(time, dt);
   if (!accelerationsValid_) computeAccelerations(time);
+  // The colliders' impulses: each kick's share of their pressure forces, and the drift's stops.
+  const bool colliding = !colliders_.empty();
   if (verlet_) {
     // Kick-drift-kick: v += dt/2 a(x_n); x += dt v; v += dt/2 a(x_n+1).
     parallelFor(0, size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) v_[i] += (0.5f * dt) * a_[i];
     });
+    if (colliding) colliders_.addWrenches(colliderForces_, 0.5 * dt);
     drift(dt);
+    if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
     computeAccelerations(time + dt);
     parallelFor(0, size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) v_[i] += (0.5f * dt) * a_[i];
     });
+    if (colliding) colliders_.addWrenches(colliderForces_, 0.5 * dt);
     accelerationsValid_ = true;  // a(x_n+1), with the half-step velocity in its viscous terms
   } else {
     // Semi-implicit Euler: v += dt a(x_n, v_n); x += dt v.
     parallelFor(0, size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) v_[i] += dt * a_[i];
     });
+    if (colliding) colliders_.addWrenches(colliderForces_, dt);
     drift(dt);
+    if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
     accelerationsValid_ = false;
   }
   time_ = time + dt;
@@ -198,6 +224,7 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
       }
       VecD unusedGradient = VecD::Zero();
       walls_.add(x_[i], weight, unusedGradient);
+      if (!colliders_.empty()) colliders_.add(x_[i], weight, unusedGradient);
       density_[i] = mass_ * weight;
       const float ratio = density_[i] / restDensity_;
       const float p = tait_ ? taitB_ * (std::pow(ratio, 7.0f) - 1.0f) : gasConstant_ * (density_[i] - restDensity_);
@@ -240,11 +267,22 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
       VecD wallGradient = VecD::Zero();
       walls_.add(x_[i], unusedWeight, wallGradient);
       pressureForce -= 2.0f * pressureTermI * wallGradient;
+      // The colliders likewise; each one's share is a force on the particle, recorded for colliders.csv.
+      if (!colliders_.empty())
+        colliders_.forEachNear(x_[i], [&](size_t c, float d, const VecD& n) {
+          float unused;
+          VecD gradient;
+          colliders_.wallTerms(d, n, unused, gradient);
+          const VecD force = -2.0f * pressureTermI * gradient;
+          pressureForce += force;
+          colliders_.addImpulse(i, c, (mass_ * mass_) * force, x_[i]);
+        });
       VecD acceleration = gravity_ + mass_ * (pressureForce + viscousForce) + nearForce;
       if (attractor_.active()) acceleration += attractor_.acceleration(x_[i], attractorAt);
       a_[i] = acceleration;
     }
   });
+  if (!colliders_.empty()) colliderForces_ = colliders_.takeSlotSums();
   times_.viscosity += millisecondsSince(start);
 }
 
@@ -252,7 +290,7 @@ template <int Dim>
 FluidMeasures WcsphSolver<Dim>::measure() {
   if (neighbors_.size() != size()) computeAccelerations(time_);
   auto sums = [&](const auto& kernel) {
-    return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, walls_, mass_, restDensity_,
+    return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, Boundary<Dim>{walls_, colliders_}, mass_, restDensity_,
                                         [&](float r2) { return kernel.value(std::sqrt(r2)); });
   };
   return wendland_ ? sums(wendland_kernel_) : sums(cubic_);

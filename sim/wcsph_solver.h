@@ -21,6 +21,7 @@
 #include "core/ply.h"
 #include "core/scene.h"
 #include "sim/attractor.h"
+#include "sim/colliders.h"
 #include "sim/kernels.h"
 #include "sim/neighbor_grid.h"
 #include "sim/measures.h"
@@ -33,7 +34,8 @@ class WcsphSolver {
  public:
   using VecD = Vec<Dim>;
 
-  explicit WcsphSolver(const Scene& scene);
+  // `shapes`: the scene's collider shapes, built once by the caller; null builds them from the scene.
+  explicit WcsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes = nullptr);
 
   void setParticles(const ParticleFrame& frame);
   void getParticles(ParticleFrame& frame) const;
@@ -56,6 +58,9 @@ class WcsphSolver {
   float speedOfSound() const { return speedOfSound_; }
   const std::vector<VecD>& positions() const { return x_; }
   const std::vector<VecD>& velocities() const { return v_; }
+  // Each collider's mean force and torque from the fluid since the last call, over `duration` seconds.
+  std::vector<Wrench> takeColliderWrenches(double duration) { return colliders_.takeFrameWrenches(duration); }
+  const Colliders<Dim>& colliders() const { return colliders_; }
   // Pressures of the last evaluation, in the particles' current order (for tests).
   const std::vector<float>& pressures() const { return pressure_; }
 
@@ -81,6 +86,8 @@ class WcsphSolver {
   std::vector<float> nearPressure_;  // only with near_pressure > 0
   NeighborGrid<Dim> grid_;
   TankWalls<Dim> walls_;
+  Colliders<Dim> colliders_;             // empty without colliders
+  std::vector<Wrench> colliderForces_;   // each collider's force at the last evaluation (for the impulses)
   NeighborLists neighbors_;
 
   bool accelerationsValid_ = false;

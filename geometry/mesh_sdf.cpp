@@ -1,0 +1,55 @@
+// The mesh's signed distance, baked with OpenVDB's mesh to volume (the only OpenVDB in geometry/), then copied
+// into a dense DistanceGrid that the simulator reads without OpenVDB.
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Dense.h>
+#include <openvdb/tools/MeshToVolume.h>
+
+#include <cmath>
+
+#include "geometry/collider_shape.h"
+
+namespace surge {
+
+DistanceGrid bakeMeshDistance(const TriangleMesh& mesh, float voxel, float band, float shellThickness) {
+  openvdb::initialize();
+  std::vector<openvdb::Vec3s> points;
+  points.reserve(mesh.positions.size());
+  Eigen::AlignedBox3f box;
+  for (const Eigen::Vector3f& p : mesh.positions) {
+    points.emplace_back(p.x(), p.y(), p.z());
+    box.extend(p);
+  }
+  std::vector<openvdb::Vec3I> triangles;
+  triangles.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
+  const std::vector<openvdb::Vec4I> quads;
+  const auto transform = openvdb::math::Transform::createLinearTransform(voxel);
+  const float reach = band + 0.5f * shellThickness;
+  const float bandVoxels = std::ceil(reach / voxel) + 2;
+  openvdb::FloatGrid::Ptr grid;
+  if (shellThickness > 0)
+    grid = openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*transform, points, triangles, quads,
+                                                                           bandVoxels);
+  else
+    grid = openvdb::tools::meshToSignedDistanceField<openvdb::FloatGrid>(*transform, points, triangles, quads,
+                                                                         bandVoxels, bandVoxels);
+  // The dense box: the mesh's box plus the band, in whole voxels.
+  openvdb::Coord lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = int(std::floor((box.min()[a] - reach) / voxel)) - 1;
+    hi[a] = int(std::ceil((box.max()[a] + reach) / voxel)) + 1;
+  }
+  const Eigen::Array3i counts(hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1);
+  DistanceGrid result(Eigen::Vector3f(lo[0], lo[1], lo[2]) * voxel, voxel, counts);
+  openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(openvdb::CoordBBox(lo, hi), result.data());
+  openvdb::tools::copyToDense(*grid, dense);
+  // Voxels of the open mesh's unsigned field are in world units (grid values); the shell is half its thickness.
+  if (shellThickness > 0) {
+    float* values = result.data();
+    const size_t n = size_t(counts.prod());
+    for (size_t i = 0; i < n; ++i) values[i] -= 0.5f * shellThickness;
+  }
+  return result;
+}
+
+}  // namespace surge

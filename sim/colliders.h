@@ -1,0 +1,179 @@
+// The scene's colliders as the solvers see them: each shape (geometry/collider_shape.h) placed at the end of
+// the current step, and
+//  - its share of a particle's density and density gradient: the tank's flat-wall table (sim/tank.h) read at
+//    the particle's signed distance, along the shape's normal there (the rest lattice continued beyond a wall
+//    that is taken locally flat; docs/colliders.md measures what that does at curved walls);
+//  - the collision response: a particle's move is swept against the shape (sphere tracing the signed distance,
+//    never a step longer than a quarter spacing inside the near band), so a wall one spacing thick cannot be
+//    crossed, and a particle that would end closer than its radius stops on the surface and keeps the part of
+//    its move along it;
+//  - friction on the velocity relative to the wall, of the particles touching it;
+//  - the force and torque the fluid exerts on each collider: every impulse a collider gives a particle is
+//    summed per collider, per chunk of 1024 particles (so the sums are the same at any thread count), and
+//    turned into the frame's mean force and torque for colliders.csv.
+// A scene without colliders has an empty Colliders: every call returns at once.
+//
+// The tank is the box container that every scene has; it stays in TankWalls, whose edges and corners are
+// tabulated exactly, and Boundary below adds the two for the solvers.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <vector>
+
+#include "core/scene.h"
+#include "geometry/collider_shape.h"
+#include "sim/kernels.h"
+#include "sim/tank.h"
+
+namespace surge {
+
+struct Wrench {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
+};
+
+using ColliderShapes = std::vector<ColliderShape>;
+
+// Builds every collider shape of the scene (reads files, bakes mesh distances); InputError on bad input.
+std::shared_ptr<const ColliderShapes> buildColliderShapes(const Scene& scene);
+
+template <int Dim>
+class Colliders {
+ public:
+  using VecD = Vec<Dim>;
+  static constexpr size_t kChunk = 1024;  // particles per force-sum slot (parallelFor's default grain)
+
+  Colliders() = default;
+  Colliders(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const FlatWallTable& table);
+
+  bool empty() const { return placed_.empty(); }
+  size_t size() const { return placed_.size(); }
+  bool hasFriction() const { return hasFriction_; }
+
+  // Places the colliders for a step from `time` to `time + dt`, at its end; each wall's velocity is its motion
+  // over the step.
+  void beginStep(double time, float dt);
+
+  // Calls visit(c, distance, normal) for every collider whose surface is within the kernel support of p.
+  template <typename Visit>
+  void forEachNear(const VecD& p, Visit&& visit) const {
+    for (size_t c = 0; c < placed_.size(); ++c) {
+      if (!placed_[c].near.contains(p)) continue;
+      VecD normal;
+      const float d = distance(c, p, normal);
+      if (d < support_) visit(c, d, normal);
+    }
+  }
+
+  // Collider c's share of sum_b W(p - p_b) (weight) and sum_b grad_p W(p - p_b) (gradient) at distance d along
+  // the normal n.
+  void wallTerms(float d, const VecD& n, float& weight, VecD& gradient) const {
+    float w, g;
+    table_.lookup(d, w, g);
+    weight = w;
+    gradient = -g * n;
+  }
+
+  // Adds every collider's share of the density sums at p (as TankWalls::add does for the tank).
+  void add(const VecD& p, float& weight, VecD& gradient) const {
+    forEachNear(p, [&](size_t, float d, const VecD& n) {
+      float w;
+      VecD g;
+      wallTerms(d, n, w, g);
+      weight += w;
+      gradient += g;
+    });
+  }
+
+  // Signed distance from p to collider c's solid in the world (negative inside) and the unit normal there.
+  float distance(size_t c, const VecD& p, VecD& normal) const;
+
+  // The collision response for a move from `from` to p (see the header comment). Calls pushed(c, delta) for each
+  // collider that moved p by delta; returns true if any did.
+  template <typename Pushed>
+  bool project(const VecD& from, VecD& p, Pushed&& pushed) const {
+    bool moved = false;
+    for (size_t c = 0; c < placed_.size(); ++c) {
+      VecD delta;
+      if (sweep(c, from, p, delta)) {
+        p += delta;
+        pushed(c, delta);
+        moved = true;
+      }
+    }
+    return moved;
+  }
+
+  // The velocity of collider c's surface at p over the current step.
+  VecD wallVelocity(size_t c, const VecD& p) const;
+  float friction(size_t c) const { return placed_[c].friction; }
+  float particleRadius() const { return radius_; }
+
+  // Particles within this distance of a collider touch it (friction acts on them).
+  float contactDistance() const { return 1.5f * radius_; }
+
+  // Force bookkeeping. resetSlots once the particle count is known; addImpulse(i, c, J, x) records that
+  // collider c gave particle i (at x) the impulse J, from inside a parallel loop whose chunks are multiples of
+  // kChunk; takeFrameWrenches returns each collider's mean force and torque (about its position) over the
+  // frame's `duration` and starts the next frame.
+  void resetSlots(size_t particles);
+  void addImpulse(size_t particle, size_t c, const VecD& impulse, const VecD& at) {
+    Wrench& w = slots_[(particle / kChunk) * placed_.size() + c];
+    Eigen::Vector3d j = Eigen::Vector3d::Zero(), r = Eigen::Vector3d::Zero();
+    j.head<Dim>() = impulse.template cast<double>();
+    r.head<Dim>() = (at - placed_[c].centre).template cast<double>();
+    w.force -= j;  // the fluid pushes the collider back
+    w.torque -= r.cross(j);
+  }
+  std::vector<Wrench> takeFrameWrenches(double duration);
+  // The slots summed per collider (in slot order) and cleared: for a solver that records forces rather than
+  // impulses (WCSPH), which then adds them times their time span with addWrenches.
+  std::vector<Wrench> takeSlotSums();
+  void addWrenches(const std::vector<Wrench>& wrenches, double scale);
+
+  // Friction: removes the fraction `friction` of the velocity along the wall, relative to the wall, of a
+  // particle (index i, mass m) touching a collider, and records the impulse.
+  void applyFriction(size_t i, const VecD& x, VecD& v, float mass);
+
+  size_t memoryBytes() const;
+
+ private:
+  struct Placed {
+    const ColliderShape* shape = nullptr;
+    Eigen::Matrix3f rotation = Eigen::Matrix3f::Identity(), previousRotation = Eigen::Matrix3f::Identity();
+    Eigen::Vector3f translation = Eigen::Vector3f::Zero(), previousTranslation = Eigen::Vector3f::Zero();
+    float scale = 1;
+    VecD centre = VecD::Zero();
+    Eigen::AlignedBox<float, Dim> near;  // particles outside it are beyond the support
+    float friction = 0;
+    bool moving = false;
+  };
+
+  bool sweep(size_t c, const VecD& from, const VecD& p, VecD& delta) const;
+
+  std::shared_ptr<const ColliderShapes> shapes_;
+  std::vector<ColliderSettings> settings_;
+  std::vector<Placed> placed_;
+  FlatWallTable table_;
+  float support_ = 0, radius_ = 0, dt_ = 1;
+  bool hasFriction_ = false;
+  std::vector<Wrench> slots_, extra_;
+};
+
+// The tank and the colliders together, as the measures see them.
+template <int Dim>
+struct Boundary {
+  const TankWalls<Dim>& tank;
+  const Colliders<Dim>& colliders;
+
+  void add(const Vec<Dim>& p, float& weight, Vec<Dim>& gradient) const {
+    tank.add(p, weight, gradient);
+    if (!colliders.empty()) colliders.add(p, weight, gradient);
+  }
+  bool contains(const Vec<Dim>& p) const { return tank.contains(p); }
+};
+
+extern template class Colliders<2>;
+extern template class Colliders<3>;
+
+}  // namespace surge
