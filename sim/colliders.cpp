@@ -15,8 +15,8 @@ std::shared_ptr<const ColliderShapes> buildColliderShapes(const Scene& scene) {
 
 template <int Dim>
 Colliders<Dim>::Colliders(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes,
-                          const FlatWallTable& table)
-    : shapes_(std::move(shapes)), settings_(scene.colliders), table_(table) {
+                          const TankWalls<Dim>& tank)
+    : shapes_(std::move(shapes)), settings_(scene.colliders), tank_(&tank) {
   if (!shapes_ && !scene.colliders.empty()) shapes_ = buildColliderShapes(scene);
   support_ = static_cast<float>(scene.solver.kernel_radius);
   radius_ = static_cast<float>(0.5 * scene.particle_spacing);

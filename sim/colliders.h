@@ -44,7 +44,8 @@ class Colliders {
   static constexpr size_t kChunk = 1024;  // particles per force-sum slot (parallelFor's default grain)
 
   Colliders() = default;
-  Colliders(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const FlatWallTable& table);
+  // `tank` must outlive this object (the solver holds both).
+  Colliders(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const TankWalls<Dim>& tank);
 
   bool empty() const { return placed_.empty(); }
   size_t size() const { return placed_.size(); }
@@ -65,13 +66,14 @@ class Colliders {
     }
   }
 
-  // Collider c's share of sum_b W(p - p_b) (weight) and sum_b grad_p W(p - p_b) (gradient) at distance d along
-  // the normal n.
-  void wallTerms(float d, const VecD& n, float& weight, VecD& gradient) const {
+  // A collider's share of sum_b W(p - p_b) (weight) and sum_b grad_p W(p - p_b) (gradient) at p, at distance d
+  // along the normal n: the flat wall's, less what it shares with a tank wall it stands square on.
+  void wallTerms(const VecD& p, float d, const VecD& n, float& weight, VecD& gradient) const {
     float w, g;
-    table_.lookup(d, w, g);
+    tank_->flatWall().lookup(d, w, g);
     weight = w;
     gradient = -g * n;
+    tank_->subtractOverlap(p, d, n, weight, gradient);
   }
 
   // Adds every collider's share of the density sums at p (as TankWalls::add does for the tank).
@@ -79,7 +81,7 @@ class Colliders {
     forEachNear(p, [&](size_t, float d, const VecD& n) {
       float w;
       VecD g;
-      wallTerms(d, n, w, g);
+      wallTerms(p, d, n, w, g);
       weight += w;
       gradient += g;
     });
@@ -154,7 +156,7 @@ class Colliders {
   std::shared_ptr<const ColliderShapes> shapes_;
   std::vector<ColliderSettings> settings_;
   std::vector<Placed> placed_;
-  FlatWallTable table_;
+  const TankWalls<Dim>* tank_ = nullptr;
   float support_ = 0, radius_ = 0, dt_ = 1;
   bool hasFriction_ = false;
   std::vector<Wrench> slots_, extra_;

@@ -37,7 +37,7 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
              static_cast<float>(scene.solver.kernel_radius),
              [&](const VecD& r) { return kernels_.poly6(r.squaredNorm()); },
              [&](const VecD& r) { return kernels_.spikyGradient(r, r.norm()); }) {
-  if (!scene.colliders.empty()) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_.flatWall());
+  if (!scene.colliders.empty()) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
   substeps_ = scene.solver.substeps;
   const SolverSettings& s = scene.solver;
   const float spacing = static_cast<float>(scene.particle_spacing);
@@ -109,18 +109,22 @@ void PbfSolver<Dim>::predictPositions(float dt, double time) {
       if (attract) v_[i] += dt * attractor_.acceleration(x_[i], attractorAt);
       p_[i] = x_[i] + dt * v_[i];
       if (!colliders_.empty()) collide(i, x_[i]);
-      walls_.clamp(p_[i]);
+      else walls_.clamp(p_[i]);
     }
   });
 }
 
-// The colliders' collision response for the move of p*_i from `from`; each push is an impulse m delta / dt
-// given to the particle (v = (x* - x) / dt at the end of the step).
+// The collision response for the move of p*_i from `from`, against the colliders and the tank; each collider's
+// push is an impulse m delta / dt given to the particle (v = (x* - x) / dt at the end of the step). Where a
+// collider meets a wall (a ball on the floor), the wall's clamp can put the particle back into the collider:
+// then both act once more, from there, so the particle ends in the corner rather than inside.
 template <int Dim>
 void PbfSolver<Dim>::collide(size_t i, const VecD& from) {
-  colliders_.project(from, p_[i], [&](size_t c, const VecD& delta) {
-    colliders_.addImpulse(i, c, (mass_ / stepDt_) * delta, p_[i]);
-  });
+  auto pushed = [&](size_t c, const VecD& delta) { colliders_.addImpulse(i, c, (mass_ / stepDt_) * delta, p_[i]); };
+  colliders_.project(from, p_[i], pushed);
+  if (walls_.clamp(p_[i]) == 0) return;
+  const VecD clamped = p_[i];
+  if (colliders_.project(clamped, p_[i], pushed)) walls_.clamp(p_[i]);
 }
 
 // Friction at the colliders, on the velocities of line 21.
@@ -260,7 +264,7 @@ void PbfSolver<Dim>::applyPositionCorrections() {
       const VecD before = p_[i];
       p_[i] += scratch_[i];
       if (!colliders_.empty()) collide(i, before);
-      walls_.clamp(p_[i]);
+      else walls_.clamp(p_[i]);
     }
   });
 }
@@ -274,7 +278,7 @@ typename PbfSolver<Dim>::VecD PbfSolver<Dim>::colliderCorrection(size_t i, const
   colliders_.forEachNear(p, [&](size_t c, float d, const VecD& n) {
     float unused;
     VecD gradient;
-    colliders_.wallTerms(d, n, unused, gradient);
+    colliders_.wallTerms(p, d, n, unused, gradient);
     const VecD move = (massOverRho_ * lambda) * gradient;
     delta += move;
     colliders_.addImpulse(i, c, (mass_ / stepDt_) * move, p);

@@ -35,6 +35,10 @@ class PbfSolver {
   // `shapes`: the scene's collider shapes, built once by the caller; null builds them from the scene.
   explicit PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes = nullptr);
 
+  // Not copyable: the colliders point at the tank's walls of this object.
+  PbfSolver(const PbfSolver&) = delete;
+  PbfSolver& operator=(const PbfSolver&) = delete;
+
   void setParticles(const ParticleFrame& frame);
   void getParticles(ParticleFrame& frame) const;
   size_t size() const { return x_.size(); }

@@ -155,6 +155,35 @@ class TankWalls {
   // The share of one flat wall at distance d (the table above): see FlatWallTable.
   const FlatWallTable& flatWall() const { return flat_; }
 
+  // A flat boundary at distance d with unit normal n (into the fluid; a collider's face) meets the tank: where
+  // it stands square on a wall within the support (|n . axis| < 0.2), the quarter of lattice beyond both was
+  // counted by each; subtracts it once (the edge table above, as add() does where two walls meet), from weight
+  // and from gradient. Other angles are left as they are (docs/colliders.md).
+  void subtractOverlap(const VecD& p, float d, const VecD& n, float& weight, VecD& gradient) const {
+    const float u2 = std::max(d, 0.0f) * edgeScale_;
+    if (!(u2 < kEdgeTableSize)) return;
+    for (int k = 0; k < Dim; ++k) {
+      if (std::abs(n[k]) >= 0.2f) continue;
+      for (int side = 0; side < 2; ++side) {
+        const float dw = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
+        const float u = std::max(dw, 0.0f) * edgeScale_;
+        if (!(u < kEdgeTableSize)) continue;
+        const int t = static_cast<int>(u), t2 = static_cast<int>(u2);
+        const float f = u - t, f2 = u2 - t2;
+        auto at = [&](int a, int b) { return edge_[a * (kEdgeTableSize + 1) + b]; };
+        const EdgeEntry e00 = at(t, t2), e01 = at(t, t2 + 1), e10 = at(t + 1, t2), e11 = at(t + 1, t2 + 1);
+        auto blend = [&](float EdgeEntry::*field) {
+          return (1 - f) * ((1 - f2) * e00.*field + f2 * e01.*field) + f * ((1 - f2) * e10.*field + f2 * e11.*field);
+        };
+        weight -= blend(&EdgeEntry::weight);
+        VecD wallNormal = VecD::Zero();
+        wallNormal[k] = side == 0 ? 1.0f : -1.0f;
+        // The quarter's gradient points towards both boundaries: -ga along the wall's normal, -gb along n.
+        gradient += blend(&EdgeEntry::gradientA) * wallNormal + blend(&EdgeEntry::gradientB) * n;
+      }
+    }
+  }
+
   // Collision response: projects p back to a particle radius inside the tank. NaN stays NaN (comparisons with
   // NaN are false), so a diverged particle is reported rather than hidden at a wall. Returns the axes moved
   // as bits, so that a solver can stop the velocity into the wall.

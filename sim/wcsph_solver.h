@@ -37,6 +37,10 @@ class WcsphSolver {
   // `shapes`: the scene's collider shapes, built once by the caller; null builds them from the scene.
   explicit WcsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes = nullptr);
 
+  // Not copyable: the colliders point at the tank's walls of this object.
+  WcsphSolver(const WcsphSolver&) = delete;
+  WcsphSolver& operator=(const WcsphSolver&) = delete;
+
   void setParticles(const ParticleFrame& frame);
   void getParticles(ParticleFrame& frame) const;
   size_t size() const { return x_.size(); }
