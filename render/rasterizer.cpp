@@ -81,6 +81,7 @@ struct Rasterizer::Impl {
   std::vector<uint8_t> buffer;
   Vec3 lo, hi;
   float size = 1;
+  bool tankEdges = true;  // render.tank: the preview draws the edges for "glass" too, nothing for "none"
 
   // Ambient sky light on a surface facing up, as the path tracer's uniform-sky integral gives it (albedo
   // times the sky's mean radiance), and the sun on a surface with normal n.
@@ -144,7 +145,110 @@ struct Rasterizer::Impl {
     glMatrixMode(GL_MODELVIEW);
     glLoadMatrixf(m);
     drawGround(camera);
-    drawTankEdges();
+    if (tankEdges) drawTankEdges();
+  }
+
+  // Everything drawn after the fluid: the colliders, and in 2D the tank's outline over all.
+  void end(const PinholeCamera& camera, const std::vector<ColliderMesh>& colliders) {
+    if (scene.dimensions == 2) {
+      // Within the tank only, like the fluid; containers and planes first, as the ground the others stand on.
+      const GLdouble tankSides[4][4] = {
+          {1, 0, 0, -lo.x()}, {-1, 0, 0, hi.x()}, {0, 1, 0, -lo.y()}, {0, -1, 0, hi.y()}};
+      for (int k = 0; k < 4; ++k) {
+        glClipPlane(GL_CLIP_PLANE1 + k, tankSides[k]);
+        glEnable(GL_CLIP_PLANE1 + k);
+      }
+      for (bool background : {true, false})
+        for (const ColliderMesh& collider : colliders)
+          if (collider.oneSided == background) drawCrossSection2d(collider);
+      for (int k = 0; k < 4; ++k) glDisable(GL_CLIP_PLANE1 + k);
+      if (tankEdges) drawOutline2d();
+      return;
+    }
+    // Pulled a hair towards the camera, so that a plane lying on the ground is drawn over it.
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(-1.0f, -1.0f);
+    for (const ColliderMesh& collider : colliders) drawCollider(camera, collider);
+    glDisable(GL_POLYGON_OFFSET_FILL);
+  }
+
+  // A collider in 3D: its albedo under sky and sun (Lambert and ambient, diffuseLight) at each vertex, with
+  // the normal turned towards the camera; of a one-sided collider only the triangles that face the camera, as
+  // the path tracer.
+  void drawCollider(const PinholeCamera& camera, const ColliderMesh& collider) {
+    const TriangleMesh& mesh = collider.mesh;
+    const std::vector<Vec3> normals = vertexNormals(mesh);
+    std::vector<Rgba> colours(mesh.positions.size());
+    for (size_t i = 0; i < mesh.positions.size(); ++i) {
+      const Vec3 n =
+          normals[i].dot(mesh.positions[i] - camera.position()) > 0 ? Vec3(-normals[i]) : normals[i];
+      colours[i] = display(collider.albedo.cwiseProduct(diffuseLight(n)), look.exposure);
+    }
+    drawTriangles(mesh.positions, colours, trianglesFacing(collider, camera.position()));
+  }
+
+  // 2D: a collider's cross-section with the plane z = 0, flat in its albedo (as sRGB, like a diagram). A
+  // closed solid holds the points (x, y, 0) from which a ray down -z crosses its surface an odd number of
+  // times: its triangles clipped to z <= 0 invert the stencil where they cover, and a quad is then filled
+  // where the stencil is odd; a container's solid is its outside, filled within the tank where the stencil is
+  // even. A plane's solid is the half-plane behind it.
+  void drawCrossSection2d(const ColliderMesh& collider) {
+    const TriangleMesh& mesh = collider.mesh;
+    if (mesh.triangles.empty()) return;
+    Rgba colour = {0, 0, 0, 255};
+    for (int k = 0; k < 3; ++k) colour[k] = encodeSrgb(std::clamp(collider.albedo[k], 0.0f, 1.0f));
+    glDisable(GL_DEPTH_TEST);
+    if (collider.plane) {
+      Vec3 centre = Vec3::Zero();
+      for (const Vec3& p : mesh.positions) centre += p;
+      centre /= float(mesh.positions.size());
+      const Vec3 n(collider.facing[0].x(), collider.facing[0].y(), 0.0f);
+      if (n.norm() < 1e-6f) return;  // a plane facing the camera: no cross-section
+      const Vec3 normal = n.normalized(), along(-normal.y(), normal.x(), 0.0f);
+      const float far = 100.0f * size;
+      centre.z() = 0;
+      drawArrays(
+          {centre + far * along, centre - far * along, centre - far * along - far * normal,
+           centre + far * along, centre - far * along - far * normal, centre + far * along - far * normal},
+          std::vector<Rgba>(6, colour));
+      return;
+    }
+    glEnable(GL_STENCIL_TEST);
+    glStencilMask(1);
+    glClearStencil(0);
+    glClear(GL_STENCIL_BUFFER_BIT);
+    glStencilFunc(GL_ALWAYS, 0, 1);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_INVERT);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    const GLdouble belowPlane[4] = {0, 0, -1, 0};  // keeps z <= 0 (the modelview is the identity in 2D)
+    glClipPlane(GL_CLIP_PLANE0, belowPlane);
+    glEnable(GL_CLIP_PLANE0);
+    glDisableClientState(GL_COLOR_ARRAY);
+    glVertexPointer(3, GL_FLOAT, 0, mesh.positions.data());
+    glDrawElements(GL_TRIANGLES, GLsizei(3 * mesh.triangles.size()), GL_UNSIGNED_INT, mesh.triangles.data());
+    glEnableClientState(GL_COLOR_ARRAY);
+    glDisable(GL_CLIP_PLANE0);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+    const bool outside = !collider.plane && collider.oneSided;  // a container
+    glStencilFunc(outside ? GL_EQUAL : GL_NOTEQUAL, 0, 1);
+    // The tank for a container; for a solid, its box in x and y (the quad only has to cover it).
+    Vec3 boxLo = lo, boxHi = hi;
+    if (!outside) {
+      boxLo = boxHi = mesh.positions[0];
+      for (const Vec3& p : mesh.positions) {
+        boxLo = boxLo.cwiseMin(p);
+        boxHi = boxHi.cwiseMax(p);
+      }
+    }
+    drawArrays({{boxLo.x(), boxLo.y(), 0},
+                {boxHi.x(), boxLo.y(), 0},
+                {boxHi.x(), boxHi.y(), 0},
+                {boxLo.x(), boxLo.y(), 0},
+                {boxHi.x(), boxHi.y(), 0},
+                {boxLo.x(), boxHi.y(), 0}},
+               std::vector<Rgba>(6, colour));
+    glDisable(GL_STENCIL_TEST);
   }
 
   // The sky as horizontal bands behind everything, coloured by the camera ray through each band.
@@ -300,7 +404,9 @@ Rasterizer::Rasterizer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   r.lo = scene.domain.min.cast<float>();
   r.hi = scene.domain.max.cast<float>();
   r.size = std::max((r.hi - r.lo).maxCoeff(), 1e-3f);
-  r.context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, nullptr);
+  r.tankEdges = scene.render.tank != "none";
+  // A stencil buffer for the 2D cross-sections of the colliders.
+  r.context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
   if (!r.context) throw RunError("OSMesa could not create a GL context");
   r.buffer.assign(size_t(r.width) * r.height * 4, 0);
   if (!OSMesaMakeCurrent(r.context, r.buffer.data(), GL_UNSIGNED_BYTE, r.width, r.height)) {
@@ -314,7 +420,7 @@ Rasterizer::~Rasterizer() {
   OSMesaDestroyContext(impl_->context);
 }
 
-Image Rasterizer::drawMesh(const TriangleMesh& water) {
+Image Rasterizer::drawMesh(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders) {
   Impl& r = *impl_;
   for (size_t t = 0; t < water.triangles.size(); ++t)
     for (uint32_t v : water.triangles[t])
@@ -338,11 +444,11 @@ Image Rasterizer::drawMesh(const TriangleMesh& water) {
   });
   r.begin(camera);
   r.drawTriangles(water.positions, colours, water.triangles);
-  if (flat) r.drawOutline2d();
+  r.end(camera, colliders);
   return r.finish();
 }
 
-Image Rasterizer::drawParticles(const ParticleFrame& particles) {
+Image Rasterizer::drawParticles(const ParticleFrame& particles, const std::vector<ColliderMesh>& colliders) {
   Impl& r = *impl_;
   OSMesaMakeCurrent(r.context, r.buffer.data(), GL_UNSIGNED_BYTE, r.width, r.height);
   const PinholeCamera camera(r.settings.camera, r.width, r.height);
@@ -379,7 +485,7 @@ Image Rasterizer::drawParticles(const ParticleFrame& particles) {
   });
   r.begin(camera);
   r.drawTriangles(positions, colours, triangles);
-  if (flat) r.drawOutline2d();
+  r.end(camera, colliders);
   return r.finish();
 }
 

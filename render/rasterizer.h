@@ -2,14 +2,16 @@
 // particles as shaded spheres, with the same camera, sky, sun and ground colours as the path tracer but no
 // refraction or shadows: each water vertex is a Fresnel blend (Schlick) of the sky it reflects and the
 // water's body colour, plus a sun highlight. Two-dimensional scenes are drawn face-on with an orthographic
-// camera as a clean picture of the fluid in the tank. Images are drawn at twice the resolution and averaged
-// down 2x2, for anti-aliased edges.
+// camera as a clean picture of the fluid in the tank. Colliders are drawn in their colour: lit by sky and sun
+// (Lambert and ambient) in 3D, as flat cross-sections with the plane z = 0 in 2D. Images are drawn at twice
+// the resolution and averaged down 2x2, for anti-aliased edges.
 #pragma once
 
 #include <memory>
 
 #include "core/ply.h"
 #include "core/scene.h"
+#include "render/colliders.h"
 #include "render/image.h"
 
 namespace surge {
@@ -24,9 +26,9 @@ class Rasterizer {
   Rasterizer& operator=(const Rasterizer&) = delete;
 
   // Throws InputError if a triangle names a vertex the mesh does not have.
-  Image drawMesh(const TriangleMesh& water);
+  Image drawMesh(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders = {});
   // Spheres of radius particle_spacing / 2 (in 2D flat discs of 0.8 particle_spacing, overlapping).
-  Image drawParticles(const ParticleFrame& particles);
+  Image drawParticles(const ParticleFrame& particles, const std::vector<ColliderMesh>& colliders = {});
 
  private:
   struct Impl;

@@ -19,7 +19,8 @@ namespace {
 
 constexpr int kTileSize = 32;
 
-Image traceImage(const RayDevice& device, const TriangleMesh& water, const Scene& scene, int frame,
+Image traceImage(const RayDevice& device, const TriangleMesh& water,
+                 const std::vector<ColliderMesh>& colliders, const Scene& scene, int frame,
                  const Shading& shading, RenderStats* stats) {
   const RenderSettings settings = resolvedRenderSettings(scene.render);
   if (settings.width <= 0 || settings.height <= 0)
@@ -29,7 +30,7 @@ Image traceImage(const RayDevice& device, const TriangleMesh& water, const Scene
   Shading look = shading;
   look.maxDepth = settings.max_depth;
 
-  const RayScene world(device, water, scene);
+  const RayScene world(device, water, scene, colliders);
   const PinholeCamera camera(settings.camera, width, height);
 
   Image image;
@@ -102,10 +103,16 @@ Image renderMesh(const TriangleMesh& water, const Scene& scene, int frame, Rende
   return renderMeshWith(water, scene, frame, Shading::fromScene(scene), stats);
 }
 
+Image renderMesh(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders, const Scene& scene,
+                 int frame, RenderStats* stats) {
+  const RayDevice device;
+  return traceImage(device, water, colliders, scene, frame, Shading::fromScene(scene), stats);
+}
+
 Image renderMeshWith(const TriangleMesh& water, const Scene& scene, int frame, const Shading& shading,
                      RenderStats* stats) {
   const RayDevice device;
-  return traceImage(device, water, scene, frame, shading, stats);
+  return traceImage(device, water, {}, scene, frame, shading, stats);
 }
 
 void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress,
@@ -129,10 +136,16 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
                      "no " + std::string(particles ? "particle" : "surface") +
                          " frame in the range (there are frames " + std::to_string(all.front()) + " to " +
                          std::to_string(all.back()) + ")");
+  // The standing colliders are read here once, a moving one's mesh with each frame.
+  ColliderMeshes colliders(dir, scene);
   if (options.resume) {
+    // A moving collider's frame file is an input of the image too; its <name>.ply is not, as the simulation
+    // writes it again when it resumes.
     const auto done = [&](int f) {
-      return isUpToDate({framePath(dir, "frames", f, "png")},
-                        {framePath(dir, particles ? "particles" : "surface", f, "ply"), dir / "scene.json"});
+      std::vector<fs::path> inputs = colliders.frameFiles(f);
+      inputs.push_back(framePath(dir, particles ? "particles" : "surface", f, "ply"));
+      inputs.push_back(dir / "scene.json");
+      return isUpToDate({framePath(dir, "frames", f, "png")}, inputs);
     };
     frames.erase(std::remove_if(frames.begin(), frames.end(), done), frames.end());
   }
@@ -142,9 +155,11 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
     Rasterizer rasterizer(scene);
     for (int frame : frames) {
       Progress::checkInterrupt();
+      const std::vector<ColliderMesh>& solids = colliders.atFrame(frame);
       const Image image =
-          particles ? rasterizer.drawParticles(readParticlePly(framePath(dir, "particles", frame, "ply")))
-                    : rasterizer.drawMesh(readMeshPly(framePath(dir, "surface", frame, "ply")));
+          particles
+              ? rasterizer.drawParticles(readParticlePly(framePath(dir, "particles", frame, "ply")), solids)
+              : rasterizer.drawMesh(readMeshPly(framePath(dir, "surface", frame, "ply")), solids);
       writePng(framePath(dir, "frames", frame, "png"), image);
       progress.advance();
     }
@@ -154,7 +169,7 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
     for (int frame : frames) {
       Progress::checkInterrupt();
       const TriangleMesh water = readMeshPly(framePath(dir, "surface", frame, "ply"));
-      const Image image = traceImage(device, water, scene, frame, shading, nullptr);
+      const Image image = traceImage(device, water, colliders.atFrame(frame), scene, frame, shading, nullptr);
       writePng(framePath(dir, "frames", frame, "png"), image);
       progress.advance();
     }

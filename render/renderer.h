@@ -1,6 +1,7 @@
-// The render stage: path-traces a water mesh in its tank (Embree 3, render/shading.h) into an sRGB image, or
-// rasterises it (or the particles) with OSMesa for a quick look (render/rasterizer.h), and turns a run's
-// surface/frame_NNNNN.ply meshes into frames/frame_NNNNN.png. Embree and GL stay behind these headers.
+// The render stage: path-traces a water mesh and the colliders in their tank (Embree 3, render/shading.h)
+// into an sRGB image, or rasterises them (or the particles) with OSMesa for a quick look
+// (render/rasterizer.h), and turns a run's surface/frame_NNNNN.ply meshes into frames/frame_NNNNN.png. Embree
+// and GL stay behind these headers.
 #pragma once
 
 #include <cstdint>
@@ -10,6 +11,7 @@
 #include "core/ply.h"
 #include "core/progress.h"
 #include "core/scene.h"
+#include "render/colliders.h"
 #include "render/image.h"  // Image, writePng, readPng
 
 namespace surge {
@@ -33,6 +35,9 @@ struct RenderStats {
 // pixel, sample): the image is the same bytes whatever the thread count. An empty mesh renders the empty
 // tank. Stops early with surge::Interrupted if the user asks to stop; InputError for a bad mesh or settings.
 Image renderMesh(const TriangleMesh& water, const Scene& scene, int frame, RenderStats* stats = nullptr);
+// The same with the colliders (render/colliders.h) in the picture.
+Image renderMesh(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders, const Scene& scene,
+                 int frame, RenderStats* stats = nullptr);
 // The same with the look given explicitly instead of Shading::fromScene(scene) (tests use a white furnace).
 Image renderMeshWith(const TriangleMesh& water, const Scene& scene, int frame, const Shading& shading,
                      RenderStats* stats = nullptr);
@@ -45,8 +50,10 @@ struct RenderOptions {
 
 // For every frame in `range` writes dir/frames/frame_NNNNN.png: from dir/surface/frame_NNNNN.ply, or with the
 // gl renderer from dir/particles/frame_NNNNN.ply when options.particles is set or there are no surface frames
-// at all. Progress: start("render", frames), advance() per frame. Throws InputError(dir, ...) if there is
-// nothing to render (or nothing in range) or the renderer is unknown, Interrupted when asked to stop.
+// at all, with the scene's visible colliders from dir/colliders/ (ColliderMeshes). Progress: start("render",
+// frames), advance() per frame. Throws InputError(dir, ...) if there is nothing to render (or nothing in
+// range) or the renderer is unknown, InputError naming the file if a collider's mesh is missing or bad,
+// Interrupted when asked to stop.
 void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress,
                   const RenderOptions& options = {});
 

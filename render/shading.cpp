@@ -17,6 +17,11 @@ constexpr float kPi = 3.14159265f;
 // Russian roulette starts after this many segments: the first bounces carry most of the image and are never
 // cut.
 constexpr int kRouletteAfter = 3;
+// The first passes of a path through or off a glass wall do not count as segments (for max_depth and the
+// roulette): a view through the tank crosses two walls, which would otherwise start the roulette at the first
+// diffuse bounce behind them and scatter its noise over the whole tank. Beyond these, a pass counts, so paths
+// caught between the walls still end.
+constexpr int kFreeGlassPasses = 8;
 // Shadow rays cross at most this many water surfaces (a splash seen edge-on); beyond, the sun counts as
 // blocked.
 constexpr int kMaxShadowCrossings = 16;
@@ -43,6 +48,20 @@ float fresnelDielectric(float cosI, float eta, float& cosT) {
   const float rs = (eta * cosI - cosT) / (eta * cosI + cosT);
   const float rp = (eta * cosT - cosI) / (eta * cosT + cosI);
   return 0.5f * (rs * rs + rp * rp);
+}
+
+// The reflectance of a thin slab of index `ior` in air for light at cosine cosI (> 0): each polarisation's
+// single-surface reflectance R becomes R + (1 - R)^2 R (1 + R^2 + R^4 + ...) = 2R / (1 + R) once the light
+// bouncing inside the slab is summed (incoherently, the pane being far thicker than a wavelength), and the
+// slab is symmetric: the same from either side. PBRT 3rd ed. eq. 8.4-8.5 for R.
+float slabReflectance(float cosI, float ior) {
+  const float eta = 1.0f / ior;
+  const float sin2T = eta * eta * std::max(0.0f, 1.0f - cosI * cosI);
+  const float cosT = std::sqrt(std::max(0.0f, 1.0f - sin2T));  // never total reflection entering glass
+  const float rs = (eta * cosI - cosT) / (eta * cosI + cosT);
+  const float rp = (eta * cosT - cosI) / (eta * cosT + cosI);
+  const float reflectS = rs * rs, reflectP = rp * rp;
+  return 0.5f * (2.0f * reflectS / (1.0f + reflectS) + 2.0f * reflectP / (1.0f + reflectP));
 }
 
 // Two unit vectors orthogonal to n (Duff et al., "Building an orthonormal basis, revisited", 2017).
@@ -82,8 +101,8 @@ Vec3 absorb(const Shading& shading, float distance) {
   return (-distance * shading.waterAbsorption).array().exp().matrix();
 }
 
-// How much sunlight arrives along a straight shadow ray: 0 if the ground blocks it, else the product of the
-// Fresnel transmissions and the absorption of the water it crosses.
+// How much sunlight arrives along a straight shadow ray: 0 if the ground or a collider blocks it, else the
+// product of the Fresnel transmissions and the absorption of the water and the glass walls it crosses.
 Vec3 sunTransmittance(const RayScene& world, const Shading& shading, const Vec3& origin,
                       const Vec3& direction, bool inside, PathStats& stats) {
   Vec3 transmittance = Vec3::Ones();
@@ -94,8 +113,13 @@ Vec3 sunTransmittance(const RayScene& world, const Shading& shading, const Vec3&
     Hit hit;
     ++stats.rays;
     if (!world.intersect(ray, kFar, hit, true)) return transmittance;
-    if (hit.kind != SurfaceKind::Water) return Vec3::Zero();
     if (inside) transmittance = transmittance.cwiseProduct(absorb(shading, hit.distance));
+    if (hit.kind == SurfaceKind::TankGlass) {
+      transmittance *= 1.0f - slabReflectance(std::abs(direction.dot(hit.geometricNormal)), shading.glassIor);
+      ray.origin = hit.passPoint;
+      continue;
+    }
+    if (hit.kind != SurfaceKind::Water) return Vec3::Zero();
     float cosT = 0;
     const float cosI = std::abs(direction.dot(hit.geometricNormal));
     transmittance *= 1.0f - fresnelDielectric(cosI, inside ? shading.ior : 1.0f / shading.ior, cosT);
@@ -184,7 +208,8 @@ namespace {
 
 // Where a path is: its next ray, whether it is in water, whether it has been specular so far (then the sun's
 // disc is seen, not sampled), how far the camera ray and its specular continuations went (checker fade), its
-// segment count and its throughput.
+// segment count, its throughput, and whether it may still split at water or at how many glass walls (see
+// gather).
 struct PathState {
   Ray ray;
   bool inside = false;  // the camera is assumed to be in air
@@ -192,14 +217,19 @@ struct PathState {
   float travelled = 0;
   int depth = 0;
   Vec3 throughput = Vec3::Ones();
+  bool splitWater = true;
+  int glassSplits = 2;
+  int glassPasses = 0;
 };
 
-// The light a path gathers from its state on. With `split`, the first water surface met sends both a
-// reflected and a refracted path, weighted F and 1 - F, instead of choosing one: the camera's view of the
-// water then shows its reflection without the speckle of a random choice at 2-10 % odds. Later water
-// surfaces choose at random (with the Fresnel probability, which keeps the estimate unbiased).
+// The light a path gathers from its state on. On the camera's direct view, the first water surface met sends
+// both a reflected and a refracted path, weighted F and 1 - F, instead of choosing one: the water then shows
+// its reflection without the speckle of a random choice at 2-10 % odds. The first two glass walls along the
+// view split the same way (most of the image is seen through the front and the back pane), and the water
+// behind them still splits once. Later surfaces choose at random (with the Fresnel probability, which keeps
+// the estimate unbiased).
 Vec3 gather(const RayScene& world, const Shading& shading, PathState path, SampleRandom& random,
-            PathStats& stats, bool split) {
+            PathStats& stats) {
   Vec3 radiance = Vec3::Zero();
   Vec3& throughput = path.throughput;
   Ray& ray = path.ray;
@@ -231,8 +261,10 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
                         refracted))
           break;
       }
-      if (split && fresnel < 1.0f) {
+      if (path.splitWater && fresnel < 1.0f) {
         PathState mirror = path, through = path;
+        mirror.splitWater = through.splitWater = false;
+        mirror.glassSplits = through.glassSplits = 0;
         ++mirror.depth;
         ++through.depth;
         mirror.ray.origin = hit.leavePoint;
@@ -242,8 +274,8 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
         through.ray.direction = refracted;
         through.inside = !path.inside;
         through.throughput *= 1.0f - fresnel;
-        return radiance + gather(world, shading, mirror, random, stats, false) +
-               gather(world, shading, through, random, stats, false);
+        return radiance + gather(world, shading, mirror, random, stats) +
+               gather(world, shading, through, random, stats);
       }
       if (fresnel >= 1.0f || random.next() < fresnel) {
         ray.origin = hit.leavePoint;
@@ -253,9 +285,40 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
         ray.direction = refracted;
         path.inside = !path.inside;
       }
+    } else if (hit.kind == SurfaceKind::TankGlass) {
+      const float reflectance = slabReflectance(-ray.direction.dot(hit.geometricNormal), shading.glassIor);
+      const Vec3 reflected = reflect(ray.direction, hit.geometricNormal);
+      const bool freePass = path.glassPasses++ < kFreeGlassPasses;
+      if (path.glassSplits > 0) {
+        PathState mirror = path, through = path;
+        mirror.glassSplits = 0;  // the reflection mostly goes to the sky
+        through.glassSplits = path.glassSplits - 1;
+        if (!freePass) {
+          ++mirror.depth;
+          ++through.depth;
+        }
+        mirror.ray.origin = hit.leavePoint;
+        mirror.ray.direction = reflected;
+        mirror.throughput *= reflectance;
+        through.ray.origin = hit.passPoint;  // straight on: the pane is too thin to shift the ray
+        through.throughput *= 1.0f - reflectance;
+        return radiance + gather(world, shading, mirror, random, stats) +
+               gather(world, shading, through, random, stats);
+      }
+      if (random.next() < reflectance) {
+        ray.origin = hit.leavePoint;
+        ray.direction = reflected;
+      } else {
+        ray.origin = hit.passPoint;
+      }
+      if (freePass) {
+        --path.depth;  // undone by the loop's increment: the pass is not a segment
+        continue;
+      }
     } else {
       const Vec3 albedo = hit.kind == SurfaceKind::Ground ? groundAlbedoAt(shading, hit.point, path.travelled)
-                                                          : Vec3::Constant(shading.tankAlbedo);
+                          : hit.kind == SurfaceKind::Collider ? hit.albedo
+                                                              : Vec3::Constant(shading.tankAlbedo);
       // Next-event estimation of the sun: (albedo / pi) L_sun cos / pdf, with pdf = 1 / solid angle of the
       // disc, which is albedo * sunColor * cos.
       const Vec3 toSun = sampleSun(shading, random);
@@ -268,7 +331,8 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
       ray.origin = hit.leavePoint;
       ray.direction = sampleCosine(hit.normal, random);
       path.specular = false;
-      split = false;  // only the camera's direct view of the water splits
+      path.splitWater = false;  // only the camera's direct view splits
+      path.glassSplits = 0;
     }
 
     if (path.depth + 1 >= kRouletteAfter) {
@@ -287,7 +351,7 @@ Vec3 traceRadiance(const RayScene& world, const Shading& shading, const Ray& cam
   PathStats local;
   PathState path;
   path.ray = cameraRay;
-  const Vec3 radiance = gather(world, shading, path, random, local, true);
+  const Vec3 radiance = gather(world, shading, path, random, local);
   if (stats) stats->rays += local.rays;
   const float peak = radiance.maxCoeff();
   return peak > kSampleClamp ? Vec3(radiance * (kSampleClamp / peak)) : radiance;

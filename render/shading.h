@@ -7,11 +7,15 @@
 //   probability F and refracts otherwise (total internal reflection when Snell has no solution), so the
 //   choice itself carries the Fresnel weight and no energy is created or lost at the interface;
 // - inside the water the throughput falls as exp(-sigma d) (Beer-Lambert), sigma per colour channel;
-// - the ground and the tank's edges are Lambertian: the sun is sampled explicitly on its disc (soft shadows)
-//   and the path continues in a cosine-distributed direction; the sky is reached by that continuation;
+// - the ground, the tank's edges and the colliders are Lambertian: the sun is sampled explicitly on its disc
+//   (soft shadows) and the path continues in a cosine-distributed direction; the sky is reached by that
+//   continuation;
+// - a glass tank's walls are slabs of clear glass too thin to shift a ray: the path reflects with the slab's
+//   reflectance 2R / (1 + R) (R the single-surface Fresnel reflectance, per polarisation; the light bouncing
+//   inside the pane summed incoherently) and goes straight on otherwise;
 // - shadow rays pass through water, weighted by its Fresnel transmission and absorption, so the tank floor
 //   under water is lit as the average of the caustics it would show (a path tracer cannot find a point sun
-//   through a refracting surface);
+//   through a refracting surface); glass walls pass the sun with the slab's transmittance;
 // - after three segments Russian roulette stops a path with probability 1 - min(max throughput, 0.95) and
 //   reweights the survivors, so the estimate stays unbiased up to max_depth.
 #pragma once
@@ -41,6 +45,7 @@ struct Shading {
   Eigen::Vector3f tankMin, tankMax;
   float hazeDistance = 100;
   float tankAlbedo = 0.04f;
+  float glassIor = 1.5f;  // the tank's walls when render.tank is "glass"
   int maxDepth = 8;
   float exposure = 1;
 

@@ -37,10 +37,12 @@ void onEmbreeError(void* user, RTCError code, const char* text) {
     impl->error = (text ? text : "") + std::string(" (error ") + std::to_string(code) + ")";
 }
 
-// Geometry ids of the three objects; the water is left out when its mesh is empty.
+// Geometry ids; the water, the tank (render.tank "none") and empty colliders are left out, collider c is
+// kFirstColliderId + c.
 constexpr unsigned kGroundId = 0;
 constexpr unsigned kTankId = 1;
 constexpr unsigned kWaterId = 2;
+constexpr unsigned kFirstColliderId = 3;
 
 // Ray masks: every object is seen by camera and reflection rays, but the tank's edges, a guide for the eye
 // rather than a real frame, cast no shadows (their thin noisy shadow lines would only clutter the picture).
@@ -87,6 +89,27 @@ void attachTriangles(RTCDevice device, RTCScene scene, unsigned id, unsigned mas
   rtcReleaseGeometry(geometry);
 }
 
+// Sets hit.normal to the mesh's vertex normals interpolated at (u, v) of `tri`, turned to the ray's side.
+void smoothShading(const TriangleMesh& mesh, const std::array<uint32_t, 3>& tri, float u, float v, Hit& hit) {
+  const auto& n = mesh.normals;
+  const float weights[3] = {1.0f - u - v, u, v};
+  const Eigen::Vector3f ns = weights[0] * n[tri[0]] + weights[1] * n[tri[1]] + weights[2] * n[tri[2]];
+  const float length = ns.norm();
+  if (length <= 1e-12f) return;
+  const float side = ns.dot(hit.geometricNormal) < 0 ? -1.0f : 1.0f;
+  hit.normal = side * ns / length;
+  // Lift the leave point onto the curved surface the vertex normals describe (Hanika, "Hacking the shadow
+  // terminator", Ray Tracing Gems II, 2021), so shadow rays of a coarse mesh do not catch the neighbouring
+  // facets and draw its triangles as dark steps.
+  Eigen::Vector3f lift = Eigen::Vector3f::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3f vertexNormal = side * n[tri[k]];
+    const float below = std::min(0.0f, (hit.point - mesh.positions[tri[k]]).dot(vertexNormal));
+    lift -= weights[k] * below * vertexNormal;
+  }
+  hit.leavePoint += lift;
+}
+
 }  // namespace
 
 RayDevice::RayDevice() : impl_(std::make_unique<Impl>()) {
@@ -103,13 +126,25 @@ RayDevice::~RayDevice() {
 struct RayScene::Impl {
   RTCScene scene = nullptr;
   const TriangleMesh* water = nullptr;
+  const std::vector<ColliderMesh>* colliders = nullptr;
+  std::vector<std::vector<std::array<uint32_t, 3>>> colliderTriangles;  // those drawn (trianglesFacing)
   bool smooth = false;
+  SurfaceKind tank = SurfaceKind::TankEdge;
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
   }
 };
 
 RayScene::RayScene(const RayDevice& device, const TriangleMesh& water, const Scene& scene)
+    : RayScene(device, water, scene, noColliders()) {}
+
+const std::vector<ColliderMesh>& RayScene::noColliders() {
+  static const std::vector<ColliderMesh> none;
+  return none;
+}
+
+RayScene::RayScene(const RayDevice& device, const TriangleMesh& water, const Scene& scene,
+                   const std::vector<ColliderMesh>& colliders)
     : impl_(std::make_unique<Impl>()) {
   const size_t vertexCount = water.positions.size();
   for (size_t t = 0; t < water.triangles.size(); ++t)
@@ -138,23 +173,58 @@ RayScene::RayScene(const RayDevice& device, const TriangleMesh& water, const Sce
                    {centre.x() - half, floorY, centre.z() + half}},
                   {{{0, 1, 2}}, {{0, 2, 3}}});
 
-  // The tank's twelve edges as square bars of half-width r (corners overlap, which reads as a frame).
-  const float r = 0.003f * size;
-  Triangles tank;
-  for (int axis = 0; axis < 3; ++axis) {
-    const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-    for (int corner = 0; corner < 4; ++corner) {
-      Eigen::Vector3f p0 = lo, p1 = hi;
-      p0[a] = p1[a] = (corner & 1) ? hi[a] : lo[a];
-      p0[b] = p1[b] = (corner & 2) ? hi[b] : lo[b];
-      tank.addBox(p0.array() - r, p1.array() + r);
+  if (scene.render.tank == "glass") {
+    // The four side walls as thin glass panes (shading.cpp treats each as a slab of no thickness), a little
+    // outside the domain so that the water's surface along a wall never coincides with them; the top is open
+    // and the ground is the floor. They filter the sun, so they are in the shadow mask.
+    impl_->tank = SurfaceKind::TankGlass;
+    const float gap = 0.002f * size;
+    const Eigen::Vector3f outerLo(lo.x() - gap, floorY, lo.z() - gap),
+        outerHi(hi.x() + gap, hi.y(), hi.z() + gap);
+    Triangles glass;
+    for (int axis : {0, 2}) {
+      const int across = 2 - axis;  // the other horizontal axis
+      for (float at : {outerLo[axis], outerHi[axis]}) {
+        const auto base = static_cast<uint32_t>(glass.positions.size());
+        for (int corner = 0; corner < 4; ++corner) {
+          Eigen::Vector3f p;
+          p[axis] = at;
+          p[across] = (corner == 1 || corner == 2) ? outerHi[across] : outerLo[across];
+          p.y() = corner >= 2 ? outerHi.y() : outerLo.y();
+          glass.positions.push_back(p);
+        }
+        glass.indices.push_back({base, base + 1, base + 2});
+        glass.indices.push_back({base, base + 2, base + 3});
+      }
     }
+    attachTriangles(dev.device, impl_->scene, kTankId, kSeen | kCastsShadow, glass.positions, glass.indices);
+  } else if (scene.render.tank != "none") {
+    // The tank's twelve edges as square bars of half-width r (corners overlap, which reads as a frame).
+    const float r = 0.003f * size;
+    Triangles tank;
+    for (int axis = 0; axis < 3; ++axis) {
+      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+      for (int corner = 0; corner < 4; ++corner) {
+        Eigen::Vector3f p0 = lo, p1 = hi;
+        p0[a] = p1[a] = (corner & 1) ? hi[a] : lo[a];
+        p0[b] = p1[b] = (corner & 2) ? hi[b] : lo[b];
+        tank.addBox(p0.array() - r, p1.array() + r);
+      }
+    }
+    attachTriangles(dev.device, impl_->scene, kTankId, kSeen, tank.positions, tank.indices);
   }
-  attachTriangles(dev.device, impl_->scene, kTankId, kSeen, tank.positions, tank.indices);
 
   if (!water.triangles.empty())
     attachTriangles(dev.device, impl_->scene, kWaterId, kSeen | kCastsShadow, water.positions,
                     water.triangles);
+  impl_->colliders = &colliders;
+  const Eigen::Vector3f camera = scene.render.camera.position.cast<float>();
+  for (size_t c = 0; c < colliders.size(); ++c) {
+    impl_->colliderTriangles.push_back(trianglesFacing(colliders[c], camera));
+    if (impl_->colliderTriangles.back().empty()) continue;
+    attachTriangles(dev.device, impl_->scene, kFirstColliderId + unsigned(c), kSeen | kCastsShadow,
+                    colliders[c].mesh.positions, impl_->colliderTriangles.back());
+  }
   rtcCommitScene(impl_->scene);
   dev.check("building the scene");
 }
@@ -182,9 +252,13 @@ bool RayScene::intersect(const Ray& ray, float maxDistance, Hit& hit, bool shado
   rtcIntersect1(impl_->scene, &context, &query);
   if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
-  hit.kind = query.hit.geomID == kWaterId  ? SurfaceKind::Water
-             : query.hit.geomID == kTankId ? SurfaceKind::TankEdge
-                                           : SurfaceKind::Ground;
+  const unsigned id = query.hit.geomID;
+  const ColliderMesh* collider =
+      id >= kFirstColliderId ? &(*impl_->colliders)[id - kFirstColliderId] : nullptr;
+  hit.kind = id == kWaterId  ? SurfaceKind::Water
+             : id == kTankId ? impl_->tank
+             : collider      ? SurfaceKind::Collider
+                             : SurfaceKind::Ground;
   hit.distance = query.ray.tfar;
   hit.point = ray.origin + hit.distance * ray.direction;
   Eigen::Vector3f ng(query.hit.Ng_x, query.hit.Ng_y, query.hit.Ng_z);
@@ -194,26 +268,13 @@ bool RayScene::intersect(const Ray& ray, float maxDistance, Hit& hit, bool shado
   hit.normal = ng;
   hit.leavePoint = hit.point + offset_ * ng;
   hit.passPoint = hit.point - offset_ * ng;
-  if (hit.kind == SurfaceKind::Water && impl_->smooth) {
-    const auto& tri = impl_->water->triangles[query.hit.primID];
-    const auto& n = impl_->water->normals;
-    const float weights[3] = {1.0f - query.hit.u - query.hit.v, query.hit.u, query.hit.v};
-    Eigen::Vector3f ns = weights[0] * n[tri[0]] + weights[1] * n[tri[1]] + weights[2] * n[tri[2]];
-    const float length = ns.norm();
-    if (length > 1e-12f) {
-      const float side = ns.dot(ng) < 0 ? -1.0f : 1.0f;  // vertex normals turned to the ray's side
-      hit.normal = side * ns / length;
-      // Lift the leave point onto the curved surface the vertex normals describe (Hanika, "Hacking the shadow
-      // terminator", Ray Tracing Gems II, 2021), so shadow rays of a coarse mesh do not catch the
-      // neighbouring facets and draw its triangles as dark steps.
-      Eigen::Vector3f lift = Eigen::Vector3f::Zero();
-      for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector3f vertexNormal = side * n[tri[k]];
-        const float below = std::min(0.0f, (hit.point - impl_->water->positions[tri[k]]).dot(vertexNormal));
-        lift -= weights[k] * below * vertexNormal;
-      }
-      hit.leavePoint += lift;
-    }
+  if (hit.kind == SurfaceKind::Water && impl_->smooth)
+    smoothShading(*impl_->water, impl_->water->triangles[query.hit.primID], query.hit.u, query.hit.v, hit);
+  if (collider) {
+    hit.albedo = collider->albedo;
+    if (collider->mesh.normals.size() == collider->mesh.positions.size())
+      smoothShading(collider->mesh, impl_->colliderTriangles[id - kFirstColliderId][query.hit.primID],
+                    query.hit.u, query.hit.v, hit);
   }
   return true;
 }

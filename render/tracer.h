@@ -1,6 +1,7 @@
-// The ray-traced world of one frame, built with Embree 3: the water mesh, a large ground plane at the tank's
-// floor and the tank's edges as thin dark bars. Embree's types stay in tracer.cpp; the rest of render/ asks
-// only "what does this ray hit" and "is this segment blocked".
+// The ray-traced world of one frame, built with Embree 3: the water mesh, the colliders, a large ground plane
+// at the tank's floor and the tank (render.tank: its edges as thin dark bars, its four side walls as thin
+// glass, or nothing). Embree's types stay in tracer.cpp; the rest of render/ asks only "what does this ray
+// hit" and "is this segment blocked".
 #pragma once
 
 #include <Eigen/Core>
@@ -9,6 +10,7 @@
 #include "core/ply.h"
 #include "core/scene.h"
 #include "render/camera.h"
+#include "render/colliders.h"
 
 namespace surge {
 
@@ -28,7 +30,7 @@ class RayDevice {
   std::unique_ptr<Impl> impl_;
 };
 
-enum class SurfaceKind { Water, Ground, TankEdge };
+enum class SurfaceKind { Water, Ground, TankEdge, TankGlass, Collider };
 
 struct Hit {
   SurfaceKind kind = SurfaceKind::Ground;
@@ -40,25 +42,31 @@ struct Hit {
   Eigen::Vector3f leavePoint = Eigen::Vector3f::Zero();
   // Where refracted rays start: the point pushed just through the surface.
   Eigen::Vector3f passPoint = Eigen::Vector3f::Zero();
+  Eigen::Vector3f albedo = Eigen::Vector3f::Zero();  // a collider's colour
 };
 
 class RayScene {
  public:
-  // Keeps a reference to `water`, which must outlive this object. Throws InputError if a triangle of `water`
-  // names a vertex it does not have, RunError if Embree fails.
+  // Keeps references to `water` and `colliders`, which must outlive this object. Of a one-sided collider only
+  // the triangles facing the scene's camera are built (trianglesFacing). Throws InputError if a triangle of
+  // `water` names a vertex it does not have, RunError if Embree fails.
+  RayScene(const RayDevice& device, const TriangleMesh& water, const Scene& scene,
+           const std::vector<ColliderMesh>& colliders);
   RayScene(const RayDevice& device, const TriangleMesh& water, const Scene& scene);
   ~RayScene();
   RayScene(const RayScene&) = delete;
   RayScene& operator=(const RayScene&) = delete;
 
   // The nearest hit along the ray closer than maxDistance, if any; a shadow ray sees only what casts
-  // shadows (not the tank's edges).
+  // shadows (not the tank's edges; glass walls and water only filter the light).
   bool intersect(const Ray& ray, float maxDistance, Hit& hit, bool shadowRay = false) const;
-  // True if anything that casts shadows (not the tank's edges) lies on the segment from origin along the unit
-  // direction up to maxDistance.
+  // True if anything that casts shadows (not the tank's edges; glass and water count as blocking here) lies
+  // on the segment from origin along the unit direction up to maxDistance.
   bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float maxDistance) const;
 
  private:
+  static const std::vector<ColliderMesh>& noColliders();
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
   float offset_ = 1e-4f;  // how far secondary rays start off a surface, relative to the tank's size

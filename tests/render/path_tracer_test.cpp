@@ -1,4 +1,5 @@
-// The path tracer's physics: energy conservation in a white furnace, and a water sphere acting as a lens.
+// The path tracer's physics: energy conservation in a white furnace, a water sphere acting as a lens, Fresnel
+// reflection off water and off a glass tank's panes.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -43,6 +44,20 @@ double meanRadiance(const RayScene& world, const Shading& shading, const Pinhole
   return sum / samples;
 }
 
+// In a white furnace every path returns 1, or after Russian roulette (survival 0.95 at throughput 1) 0 or
+// 1/0.95^k: its standard deviation is at most sqrt(0.05 k) ~ 0.5 for the few roulette steps a path here takes,
+// so the mean of 4096 paths is within 0.5 / 64 ~ 0.008 of its expectation; 0.03 is almost four of those. An
+// error in the Fresnel weights or the Lambertian sampling shifts the mean by far more (dropping the 1 - F
+// factor of a refraction alone: ~0.04 per crossing).
+template <size_t N>
+void expectFurnaceBalance(const RayScene& world, const Shading& shading, const PinholeCamera& camera,
+                          const float (&points)[N][2]) {
+  for (const auto& p : points) {
+    const double mean = meanRadiance(world, shading, camera, p[0], p[1], 4096);
+    EXPECT_NEAR(mean, 1.0, 0.03) << "image point " << p[0] << "," << p[1];
+  }
+}
+
 TEST(PathTracerTest, WhiteFurnaceConservesEnergy) {
   const Scene scene = unitTankScene();
   const Shading shading = whiteFurnace(scene);
@@ -56,15 +71,55 @@ TEST(PathTracerTest, WhiteFurnaceConservesEnergy) {
   // (Fresnel splits, refractions, total internal reflections, bounces off the floor under it) and past its
   // rim.
   const float points[][2] = {{4, 44}, {60, 44}, {cx, cy}, {cx + 3, cy - 2}, {cx - 4, cy + 1}};
-  for (const auto& p : points) {
-    // Each path returns 1, or after Russian roulette (survival 0.95 at throughput 1) 0 or 1/0.95^k: its
-    // standard deviation is at most sqrt(0.05 k) ~ 0.5 for the few roulette steps a path here takes, so the
-    // mean of 4096 paths is within 0.5 / 64 ~ 0.008 of its expectation; 0.03 is almost four of those.
-    // An error in the Fresnel weights or the Lambertian sampling shifts the mean by far more (dropping the
-    // 1 - F factor of a refraction alone: ~0.04 per crossing).
-    const double mean = meanRadiance(world, shading, camera, p[0], p[1], 4096);
-    EXPECT_NEAR(mean, 1.0, 0.03) << "image point " << p[0] << "," << p[1];
-  }
+  expectFurnaceBalance(world, shading, camera, points);
+}
+
+TEST(PathTracerTest, GlassWallsAndCollidersConserveEnergyInTheWhiteFurnace) {
+  // The furnace again, in a glass tank, with a white collider (albedo 1) beside the water ball: rays through
+  // the panes (split, reflected or passed) and off the collider must still bring back exactly 1 on average.
+  const Scene scene = unitTankScene(R"("tank": "glass")");
+  const Shading shading = whiteFurnace(scene);
+  const RayDevice device;
+  const TriangleMesh ball = sphereMesh({0.5f, 0.4f, 0.5f}, 0.25f, 24);
+  ColliderSettings white;
+  white.color = Eigen::Vector3d::Ones();
+  const std::vector<ColliderMesh> colliders = {
+      makeColliderMesh(white, testing::boxMeshWithFaceNormals({0.8f, 0.0f, 0.2f}, {0.95f, 0.3f, 0.8f}))};
+  const RayScene world(device, ball, scene, colliders);
+  const PinholeCamera camera(scene.render.camera, 64, 48);
+  float cx = 0, cy = 0, bx = 0, by = 0;
+  ASSERT_TRUE(camera.project({0.5f, 0.4f, 0.5f}, cx, cy));
+  ASSERT_TRUE(camera.project({0.875f, 0.3f, 0.5f}, bx, by));
+  // Through the front pane onto the floor, into the ball, onto the collider's top, and over the tank's rim.
+  const float points[][2] = {{cx - 8, cy + 8}, {cx, cy}, {cx + 3, cy - 2}, {bx, by}, {32, 8}};
+  expectFurnaceBalance(world, shading, camera, points);
+}
+
+TEST(PathTracerTest, GlassPaneReflectsAsAThinSlab) {
+  // A ray meets the front pane of a glass tank; behind the pane a black collider swallows all that passes,
+  // and the reflection goes to a sky of radiance 1. The first pane splits deterministically, so the radiance
+  // is the slab's reflectance exactly: per polarisation 2R / (1 + R) of the single-surface Fresnel R, at
+  // index 1.5. Head on R = 0.04 for both: 0.0769. At 60 degrees Rs = 0.1766, Rp = 0.0018: 0.1519 (a single
+  // surface would give 0.089, the unpolarised R put through 2R / (1 + R) 0.164).
+  const Scene scene = unitTankScene(R"("tank": "glass")");
+  const Shading shading = whiteFurnace(scene);
+  const RayDevice device;
+  const TriangleMesh noWater;
+  ColliderSettings black;
+  black.color = Eigen::Vector3d::Zero();
+  const std::vector<ColliderMesh> blackBox = {
+      makeColliderMesh(black, testing::boxMeshWithFaceNormals({0.05f, 0.05f, 0.05f}, {0.95f, 0.95f, 0.95f}))};
+  const RayScene world(device, noWater, scene, blackBox);
+  const auto reflectance = [&](float degrees) {
+    const float a = float(degrees * M_PI / 180);
+    Ray ray;
+    ray.direction = Eigen::Vector3f(-std::sin(a), 0, -std::cos(a));
+    ray.origin = Eigen::Vector3f(0.5f, 0.5f, 1.0f) - 2.0f * ray.direction;  // meets the pane near (0.5, 0.5)
+    SampleRandom random(0, 0, 0);
+    return traceRadiance(world, shading, ray, random)[0];
+  };
+  EXPECT_NEAR(reflectance(0), 0.0769, 0.001);
+  EXPECT_NEAR(reflectance(60), 0.1519, 0.001);
 }
 
 // Looking straight down on a clear water ball hanging above a ground whose left half (x < 1) is dark and
