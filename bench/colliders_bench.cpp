@@ -1,0 +1,119 @@
+// Colliders' costs (issue: colliders), printed as a markdown table for docs/performance.md:
+//  - baking a mesh of 100,000 triangles (a torus) into its distance field, as `surge sim` does when it reads
+//    the scene (read the OBJ, check it is closed, OpenVDB's mesh to volume, copy to the dense grid), wall time;
+//  - the colliders' share of a PBF step: 100,000 particles in a pool with that torus lying in the water, stepped
+//    with the collider and then, from the very same particle state, without it; the share is 1 - t_without /
+//    t_with, both timed in this process, alternating, best of several rounds;
+//  - the memory the collider holds.
+// Run: build/bench/surge_bench_colliders [threads]   (default: all cores)
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
+#include "core/parallel.h"
+#include "sim/pbf_solver.h"
+#include "sim/simulation.h"
+
+namespace surge {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// A torus about the y axis (major radius R, minor r), u x v quads as 2 u v triangles, written as OBJ.
+void writeTorusObj(const fs::path& path, double major, double minor, int u, int v) {
+  std::ofstream out(path);
+  for (int i = 0; i < u; ++i)
+    for (int j = 0; j < v; ++j) {
+      const double a = 2 * M_PI * i / u, b = 2 * M_PI * j / v;
+      const double ring = major + minor * std::cos(b);
+      out << "v " << ring * std::cos(a) << " " << minor * std::sin(b) << " " << ring * std::sin(a) << "\n";
+    }
+  auto index = [&](int i, int j) { return (i % u) * v + (j % v) + 1; };
+  for (int i = 0; i < u; ++i)
+    for (int j = 0; j < v; ++j) {
+      out << "f " << index(i, j) << " " << index(i, j + 1) << " " << index(i + 1, j + 1) << "\n";
+      out << "f " << index(i, j) << " " << index(i + 1, j + 1) << " " << index(i + 1, j) << "\n";
+    }
+}
+
+Scene pool(const std::string& colliders) {
+  return parseScene(R"({"name": "bench", "dimensions": 3, "domain": {"min": [0, 0, 0], "max": [0.6, 0.5, 0.6]},
+    "particle_spacing": 0.01, "fluids": [{"box": {"min": [0, 0, 0], "max": [0.6, 0.32, 0.6]}}],
+    "colliders": )" + colliders + "}",
+                    "bench");
+}
+
+template <typename Solver>
+double timeSteps(Solver& solver, int steps, double& time) {
+  const float dt = 1.0f / 120;
+  const auto start = Clock::now();
+  for (int s = 0; s < steps; ++s) {
+    solver.step(dt, time);
+    time += dt;
+  }
+  return secondsSince(start) / steps;
+}
+
+}  // namespace
+}  // namespace surge
+
+int main(int argc, char** argv) {
+  using namespace surge;
+  const int threads = argc > 1 ? std::atoi(argv[1]) : 0;
+  ThreadLimit limit(threads);
+  const fs::path obj = fs::temp_directory_path() / "surge_bench_torus.obj";
+  writeTorusObj(obj, 0.15, 0.06, 250, 200);  // 100,000 triangles
+  const std::string collider =
+      R"([{"name": "torus", "shape": "mesh", "file": ")" + obj.string() + R"(", "position": [0.3, 0.1, 0.3]}])";
+  const Scene withMesh = pool(collider);
+
+  auto start = Clock::now();
+  const std::shared_ptr<const ColliderShapes> shapes = buildColliderShapes(withMesh);
+  const double bake = secondsSince(start);
+  const ColliderShape& torus = shapes->front();
+
+  PbfSolver<3> with(withMesh, shapes);
+  {
+    ParticleFrame initial = initialParticles(withMesh);
+    std::vector<Eigen::Vector3f> kept;
+    ParticleFrame frame;
+    for (size_t i = 0; i < initial.size(); ++i) {
+      Eigen::Vector3f normal;
+      if (with.colliders().distance(0, initial.position[i], normal) < 0.99f * with.colliders().particleRadius()) continue;
+      frame.position.push_back(initial.position[i]);
+      frame.velocity.push_back(initial.velocity[i]);
+      frame.id.push_back(uint32_t(frame.id.size()));
+    }
+    with.setParticles(frame);
+  }
+  double time = 0;
+  timeSteps(with, 24, time);  // settle a little: the water presses on the torus
+  const Scene withoutMesh = pool("[]");
+  PbfSolver<3> without(withoutMesh);
+  double bestWith = 1e30, bestWithout = 1e30;
+  for (int round = 0; round < 4; ++round) {
+    ParticleFrame state;
+    with.getParticles(state);
+    without.setParticles(state);
+    double t0 = time, t1 = time;
+    bestWithout = std::min(bestWithout, timeSteps(without, 8, t0));
+    bestWith = std::min(bestWith, timeSteps(with, 8, t1));
+    time = t1;
+  }
+  std::printf("| measure | value |\n|---|---|\n");
+  std::printf("| threads | %d |\n", threads > 0 ? threads : ThreadLimit::available());
+  std::printf("| mesh triangles | %zu |\n", torus.mesh.triangles.size());
+  std::printf("| bake: read OBJ, check closed, mesh to distance grid | %.2f s |\n", bake);
+  std::printf("| distance grid | %d x %d x %d voxels of %.4f m, %.1f MB |\n", torus.grid.counts()[0],
+              torus.grid.counts()[1], torus.grid.counts()[2], torus.grid.voxel(), torus.memoryBytes() / 1e6);
+  std::printf("| particles | %zu |\n", with.size());
+  std::printf("| PBF step with the torus | %.1f ms |\n", 1e3 * bestWith);
+  std::printf("| PBF step, same particles, no collider | %.1f ms |\n", 1e3 * bestWithout);
+  std::printf("| colliders' share of a step | %.1f%% |\n", 100 * (1 - bestWithout / bestWith));
+  fs::remove(obj);
+  return 0;
+}
