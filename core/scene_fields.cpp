@@ -74,7 +74,9 @@ void visitCollider(SceneVisitor& v, ColliderSettings& c) {
         v.vector("position", c.motion[i].position, required("position at that time", "m"));
         visitRotation(v, c.motion[i].rotation);
       });
-  v.real("friction", c.friction, atLeast(0, "0: free slip; 1: no slip", "", 1));
+  v.real("friction", c.friction,
+         atLeast(0, "the fraction of the fluid's sliding velocity along the wall taken away over each 1/30 s of "
+                    "contact: 0 free slip, 1 no slip", "", 1));
   v.vector("color", c.color, atLeast(0, "linear RGB albedo in the renders", "", 1), true);
   v.integer("visible", c.visible, atLeast(0, "0: simulated but not drawn", "", 1));
 }

@@ -44,6 +44,10 @@ void Colliders<Dim>::beginStep(double time, float dt) {
     k.previousRotation = start.rotation.toRotationMatrix().cast<float>();
     k.previousTranslation = start.translation.cast<float>();
     k.scale = static_cast<float>(end.scale);
+    // friction is the fraction of the sliding velocity taken away over kFrictionTime of contact, so that it
+    // means the same at any number of substeps: over a step dt, 1 - (1 - friction)^(dt / kFrictionTime).
+    k.frictionThisStep =
+        k.friction >= 1 ? 1.0f : static_cast<float>(1 - std::pow(1.0 - k.friction, double(dt) / kFrictionTime));
     k.centre = k.translation.template head<Dim>();
     // The near box: the shape's box at both ends of the step, grown by the support. A plane and a container
     // reach everywhere.
@@ -84,38 +88,63 @@ float Colliders<Dim>::distance(size_t c, const VecD& p, VecD& normal) const {
 }
 
 template <int Dim>
-bool Colliders<Dim>::sweep(size_t c, const VecD& from, const VecD& p, VecD& delta) const {
+bool Colliders<Dim>::sweep(size_t c, const VecD& from, const VecD& p, bool fromStepStart, VecD& delta) const {
   const Placed& k = placed_[c];
   const Eigen::AlignedBox<float, Dim> segment(from.cwiseMin(p), from.cwiseMax(p));
   if (!k.near.intersects(segment)) return false;
-  const VecD move = p - from;
+  // The move in the shape's frame (unscaled): a straight line from where `from` was relative to the shape to
+  // where p is relative to it.
+  Eigen::Vector3f a = Eigen::Vector3f::Zero(), b = Eigen::Vector3f::Zero();
+  a.head<Dim>() = from;
+  b.head<Dim>() = p;
+  const bool atStart = fromStepStart && k.moving;
+  const Eigen::Vector3f q0 = (atStart ? k.previousRotation : k.rotation).transpose() *
+                             (a - (atStart ? k.previousTranslation : k.translation)) / k.scale;
+  const Eigen::Vector3f q1 = k.rotation.transpose() * (b - k.translation) / k.scale;
+  const Eigen::Vector3f move = q1 - q0;
   const float length = move.norm();
   if (!std::isfinite(length)) return false;  // a diverged particle is reported, not moved
-  VecD normal;
-  const float atEnd = distance(c, p, normal);
-  // Every point of the segment is at least atEnd - length from the solid (a distance is 1-Lipschitz).
-  if (atEnd >= radius_ + length) return false;
-  // Sphere tracing from `from`: steps as long as the distance allows, and at least half a radius. A wall one
-  // spacing (two radii) thick has a band four radii deep closer than a radius, which no step can cross.
-  const float shortest = 0.5f * radius_;
-  float t = 0, d = 0;
-  VecD at = from;
+  const float radius = radius_ / k.scale;
+  const ColliderShape& shape = *k.shape;
+  Eigen::Vector3f normal;
+  // Every point of the move is at least atEnd - length from the solid (a distance is 1-Lipschitz).
+  const float atEnd = shape.distance(q1, normal);
+  if (atEnd >= radius + length) return false;
+  // Sphere tracing from q0: steps as long as the distance allows, and at least half a radius. A wall one
+  // spacing (two radii) thick has a band four radii deep closer than a radius, which no step can cross. The
+  // move stops where it comes closer than a radius while approaching the wall: a particle already that close
+  // and moving away (the density pushing it off) goes on.
+  const float shortest = 0.5f * radius;
+  float t = 0, d = 0, previous = INFINITY;
+  Eigen::Vector3f at = q0;
+  bool hit = false;
   while (true) {
-    at = length > 0 ? VecD(from + (t / length) * move) : from;
-    d = distance(c, at, normal);
-    if (d < radius_) break;
-    if (t >= length) return false;
-    t = std::min(length, t + std::max(d - radius_, shortest));
+    at = length > 0 ? Eigen::Vector3f(q0 + (t / length) * move) : q0;
+    d = shape.distance(at, normal);
+    if (d < radius && (t > 0 ? d < previous : move.dot(normal) < 0)) {
+      hit = true;
+      break;
+    }
+    if (t >= length) break;
+    previous = d;
+    t = std::min(length, t + std::max(d - radius, shortest));
   }
-  // Stop on the surface at a radius and keep the rest of the move along it.
-  VecD target = at + (radius_ - d) * normal;
-  VecD rest = p - at;
-  rest -= rest.dot(normal) * normal;
-  target += rest;
-  VecD after;
-  const float landed = distance(c, target, after);
-  if (landed < radius_) target += (radius_ - landed) * after;
-  delta = target - p;
+  Eigen::Vector3f target;
+  if (hit) {
+    // Stop on the surface at a radius and keep the rest of the move along it.
+    target = at + (radius - d) * normal;
+    Eigen::Vector3f rest = q1 - at;
+    rest -= rest.dot(normal) * normal;
+    target += rest;
+  } else if (atEnd < radius) {
+    target = q1;  // moved off the wall, not yet a radius away: lifted below
+  } else {
+    return false;
+  }
+  const float landed = shape.distance(target, normal);
+  if (landed < radius) target += (radius - landed) * normal;
+  const Eigen::Vector3f world = k.translation + k.rotation * (k.scale * target);
+  delta = world.head<Dim>() - p;
   return true;
 }
 
@@ -171,7 +200,7 @@ std::vector<Wrench> Colliders<Dim>::takeFrameWrenches(double duration) {
 template <int Dim>
 void Colliders<Dim>::applyFriction(size_t i, const VecD& x, VecD& v, float mass) {
   forEachNear(x, [&](size_t c, float d, const VecD& n) {
-    const float mu = placed_[c].friction;
+    const float mu = placed_[c].frictionThisStep;
     if (mu == 0 || d >= contactDistance()) return;
     const VecD relative = v - wallVelocity(c, x);
     const VecD tangential = relative - relative.dot(n) * n;

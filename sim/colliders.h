@@ -7,7 +7,8 @@
 //    never a step longer than a quarter spacing inside the near band), so a wall one spacing thick cannot be
 //    crossed, and a particle that would end closer than its radius stops on the surface and keeps the part of
 //    its move along it;
-//  - friction on the velocity relative to the wall, of the particles touching it;
+//  - friction on the velocity relative to the wall, of the particles touching it: `friction` of it taken away
+//    over each 1/30 s of contact (the same at any step), all of it at 1;
 //  - the force and torque the fluid exerts on each collider: every impulse a collider gives a particle is
 //    summed per collider, per chunk of 1024 particles (so the sums are the same at any thread count), and
 //    turned into the frame's mean force and torque for colliders.csv.
@@ -42,6 +43,7 @@ class Colliders {
  public:
   using VecD = Vec<Dim>;
   static constexpr size_t kChunk = 1024;  // particles per force-sum slot (parallelFor's default grain)
+  static constexpr double kFrictionTime = 1.0 / 30;  // friction's fraction is taken away over this long
 
   Colliders() = default;
   // `tank` must outlive this object (the solver holds both).
@@ -90,14 +92,16 @@ class Colliders {
   // Signed distance from p to collider c's solid in the world (negative inside) and the unit normal there.
   float distance(size_t c, const VecD& p, VecD& normal) const;
 
-  // The collision response for a move from `from` to p (see the header comment). Calls pushed(c, delta) for each
-  // collider that moved p by delta; returns true if any did.
+  // The collision response for a move from `from` to p (see the header comment). The move is swept in each
+  // collider's own frame: `from` as it stood at the step's start when fromStepStart (the first move of a step),
+  // else at its end, p at the end; so a moving wall meets a particle with the face that moves into it. Calls
+  // pushed(c, delta) for each collider that moved p by delta; returns true if any did.
   template <typename Pushed>
-  bool project(const VecD& from, VecD& p, Pushed&& pushed) const {
+  bool project(const VecD& from, VecD& p, bool fromStepStart, Pushed&& pushed) const {
     bool moved = false;
     for (size_t c = 0; c < placed_.size(); ++c) {
       VecD delta;
-      if (sweep(c, from, p, delta)) {
+      if (sweep(c, from, p, fromStepStart, delta)) {
         p += delta;
         pushed(c, delta);
         moved = true;
@@ -147,11 +151,11 @@ class Colliders {
     float scale = 1;
     VecD centre = VecD::Zero();
     Eigen::AlignedBox<float, Dim> near;  // particles outside it are beyond the support
-    float friction = 0;
+    float friction = 0, frictionThisStep = 0;
     bool moving = false;
   };
 
-  bool sweep(size_t c, const VecD& from, const VecD& p, VecD& delta) const;
+  bool sweep(size_t c, const VecD& from, const VecD& p, bool fromStepStart, VecD& delta) const;
 
   std::shared_ptr<const ColliderShapes> shapes_;
   std::vector<ColliderSettings> settings_;

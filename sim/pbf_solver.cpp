@@ -108,7 +108,7 @@ void PbfSolver<Dim>::predictPositions(float dt, double time) {
       v_[i] += dt * gravity_;
       if (attract) v_[i] += dt * attractor_.acceleration(x_[i], attractorAt);
       p_[i] = x_[i] + dt * v_[i];
-      if (!colliders_.empty()) collide(i, x_[i]);
+      if (!colliders_.empty()) collide(i, x_[i], true);
       else walls_.clamp(p_[i]);
     }
   });
@@ -119,12 +119,12 @@ void PbfSolver<Dim>::predictPositions(float dt, double time) {
 // collider meets a wall (a ball on the floor), the wall's clamp can put the particle back into the collider:
 // then both act once more, from there, so the particle ends in the corner rather than inside.
 template <int Dim>
-void PbfSolver<Dim>::collide(size_t i, const VecD& from) {
+void PbfSolver<Dim>::collide(size_t i, const VecD& from, bool fromStepStart) {
   auto pushed = [&](size_t c, const VecD& delta) { colliders_.addImpulse(i, c, (mass_ / stepDt_) * delta, p_[i]); };
-  colliders_.project(from, p_[i], pushed);
+  colliders_.project(from, p_[i], fromStepStart, pushed);
   if (walls_.clamp(p_[i]) == 0) return;
   const VecD clamped = p_[i];
-  if (colliders_.project(clamped, p_[i], pushed)) walls_.clamp(p_[i]);
+  if (colliders_.project(clamped, p_[i], false, pushed)) walls_.clamp(p_[i]);
 }
 
 // Friction at the colliders, on the velocities of line 21.
@@ -263,7 +263,7 @@ void PbfSolver<Dim>::applyPositionCorrections() {
     for (size_t i = b; i < e; ++i) {
       const VecD before = p_[i];
       p_[i] += scratch_[i];
-      if (!colliders_.empty()) collide(i, before);
+      if (!colliders_.empty()) collide(i, before, false);
       else walls_.clamp(p_[i]);
     }
   });

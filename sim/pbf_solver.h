@@ -73,7 +73,7 @@ class PbfSolver {
   double computeLambdas();  // returns the average density error before this iteration's correction
   void applyPositionCorrections();
   void updateVelocities(float dt);
-  void collide(size_t i, const VecD& from);
+  void collide(size_t i, const VecD& from, bool fromStepStart);
   VecD colliderCorrection(size_t i, const VecD& p, float lambda);
   void applyFriction();
   void applyVorticityConfinement(float dt);

@@ -134,7 +134,7 @@ void WcsphSolver<Dim>::drift(float dt) {
       x_[i] += dt * v_[i];
       if (!colliders_.empty()) {
         // Stopped at a collider: no velocity into it, relative to its own; the change is the collider's impulse.
-        colliders_.project(from, x_[i], [&](size_t c, const VecD& delta) {
+        colliders_.project(from, x_[i], true, [&](size_t c, const VecD& delta) {
           const float length = delta.norm();
           if (!(length > 0)) return;
           const VecD n = delta / length;

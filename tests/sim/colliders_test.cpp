@@ -115,12 +115,14 @@ TEST(Colliders, ThinPlateHoldsAFastColumn) {
   EXPECT_GT(closest, 1.0f - 0.05f);
 }
 
-// Rest against a shape: a pool 20 spacings deep with the collider in it settles for 2 s; then, over 0.5 s:
+// Rest against a shape: a pool 20 spacings deep with the collider in it settles for 2 s; then, over 1 s:
 //  - the motion and the average density error are no worse than the same pool's without the collider (PBF at
 //    its default 4 substeps x 4 iterations leaves a 20-deep pool about 4% compressed and trembling at an RMS
-//    speed of about 0.025 m/s; the collider must not add to that): the RMS speed within 1.5 times, the error
-//    within 0.5% more. The fastest single particle, at the contact line where the free surface meets the
-//    collider, within 3 times the pool's own fastest (measured: 1.4 to 2.7 times, 0.19 to 0.36 m/s);
+//    speed of about 0.023 m/s; the collider must not add to that): the RMS speed within twice the pool's (a
+//    pool's tremble differs from one shape of it to another by up to half: measured 0.87 to 1.48 times), the
+//    error within 0.5% more. The fastest single particle, at the contact line where the free surface meets
+//    the collider, within 3 times the pool's own fastest (measured 1.1 to 2.2 times). A collider that pumps
+//    energy shows in ImpactOnAPlaneIsAnImpactOnTheFloor below;
 //  - no particle is inside the collider (closer than 0.95 radii);
 //  - the fluid touching the collider has the interior's number density, neither a gap nor a pile: the particles
 //    within 3 spacings of the surface against the count the lattice puts in that band (its area, measured on a
@@ -140,13 +142,14 @@ PoolMotion settleAndWatch(Solver& solver, const Scene& scene) {
   double time = 0;
   runFor(solver, scene, 2.0, time);
   PoolMotion m;
-  for (int frame = 0; frame < 15; ++frame) {
+  constexpr int kFrames = 30;
+  for (int frame = 0; frame < kFrames; ++frame) {
     runFor(solver, scene, 1.0 / 30, time);
     for (const auto& v : solver.velocities()) {
       m.fastest = std::max(m.fastest, v.norm());
-      m.rmsSpeed += v.squaredNorm() / (15.0 * solver.size());
+      m.rmsSpeed += v.squaredNorm() / (double(kFrames) * solver.size());
     }
-    m.densityError += solver.measure().densityErrorAvg / 15;
+    m.densityError += solver.measure().densityErrorAvg / kFrames;
   }
   m.rmsSpeed = std::sqrt(m.rmsSpeed);
   return m;
@@ -174,7 +177,7 @@ TEST_P(RestAgainst, Shape) {
   solver.setParticles(withoutInside<2>(scene, solver.colliders()));
   const PoolMotion motion = settleAndWatch(solver, scene);
   const PoolMotion& reference = poolWithoutColliders();
-  EXPECT_LT(motion.rmsSpeed, 1.5 * reference.rmsSpeed) << GetParam().name;
+  EXPECT_LT(motion.rmsSpeed, 2.0 * reference.rmsSpeed) << GetParam().name;
   EXPECT_LT(motion.fastest, 3.0f * reference.fastest) << GetParam().name;
   EXPECT_LT(motion.densityError, reference.densityError + 0.005) << GetParam().name;
   EXPECT_GT(closestApproach<2>(solver), 0.95f) << GetParam().name;
@@ -354,6 +357,37 @@ TEST(Colliders, MovingPaddleMovesWater) {
     Eigen::Vector2f n;
     EXPECT_GT(solver.colliders().distance(0, p, n), 0.95f * solver.colliders().particleRadius());
   }
+}
+
+}  // namespace
+}  // namespace surge
+
+namespace surge {
+namespace {
+
+// A block dropped 0.1 m onto a plane collider must land as it lands on the tank's floor at the same height (the
+// same table, the same clamp to a radius): the kinetic energy frame by frame within 10% plus 1 J/m (after the
+// impact the two runs part like any two chaotic splashes, so only the peak and the first frames after it are
+// compared). A collision that held back particles moving off the wall (the density pushing them away) once
+// made the plane's impact 7 times as energetic as the floor's, with 60-fold compression.
+TEST(Colliders, ImpactOnAPlaneIsAnImpactOnTheFloor) {
+  const std::string fluid = R"([{"box": {"min": [0.03, 0.6], "max": [0.45, 1.0]}}])";
+  const Scene onPlane = makeScene(2, R"({"min": [0, 0], "max": [2, 1.5]})", fluid,
+                                  R"([{"shape": "plane", "position": [0, 0.5], "normal": [0, 1]}])", 0.005);
+  const Scene onFloor = makeScene(2, R"({"min": [0, 0.5], "max": [2, 1.5]})", fluid, "[]", 0.005);
+  PbfSolver<2> plane(onPlane), floor(onFloor);
+  plane.setParticles(initialParticles(onPlane));
+  floor.setParticles(initialParticles(onFloor));
+  double tp = 0, tf = 0, peakPlane = 0, peakFloor = 0;
+  for (int frame = 1; frame <= 9; ++frame) {
+    runFor(plane, onPlane, 1.0 / 30, tp);
+    runFor(floor, onFloor, 1.0 / 30, tf);
+    const double ep = plane.measure().kineticEnergy, ef = floor.measure().kineticEnergy;
+    peakPlane = std::max(peakPlane, ep);
+    peakFloor = std::max(peakFloor, ef);
+    EXPECT_NEAR(ep, ef, 0.1 * ef + 1) << "frame " << frame;
+  }
+  EXPECT_NEAR(peakPlane, peakFloor, 0.1 * peakFloor);
 }
 
 }  // namespace
