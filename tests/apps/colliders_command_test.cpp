@@ -125,3 +125,32 @@ TEST(CollidersCommand, BadInputIsOneLineAndWritesNothing) {
 
 }  // namespace
 }  // namespace surge
+
+namespace surge {
+namespace {
+
+// An open mesh (one square, as users bring them) is given the spacing as its thickness, says so in one line,
+// and holds the water: nothing falls through it.
+TEST(CollidersCommand, OpenMeshBecomesAShellAndSaysSo) {
+  const std::string dir = testing::TempDir();
+  std::ofstream(dir + "/square.obj") << "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nf 1 3 2\nf 1 4 3\n";
+  std::string text = kObstacles;
+  const size_t start = text.find("\"colliders\""), end = text.find("\"output\"");
+  text.replace(start, end - start,
+               R"("colliders": [{"name": "sheet", "shape": "mesh", "file": "square.obj", "position": [0.4, 0.15, 0.15]}],
+  )");
+  const fs::path scene = writeTestScene("open_mesh.json", text);
+  const fs::path out = fs::path(testing::TempDir()) / "open_mesh_out";
+  fs::remove_all(out);
+  const SurgeResult r = runSurge("sim '" + scene.string() + "' --set 'fluids[0].box.min=[0,0.2,0]' "
+                                 "--set 'fluids[0].box.max=[0.8,0.4,0.3]' --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("sim: colliders[0] (square.obj) is open or non-manifold: treated as a shell 0.025 m thick"),
+            std::string::npos)
+      << r.out;
+  const ParticleFrame last = readParticlePly(framePath(out, "particles", 6, "ply"));
+  for (const Eigen::Vector3f& p : last.position) EXPECT_GT(p.y(), 0.15f) << "a particle fell through the sheet";
+}
+
+}  // namespace
+}  // namespace surge
