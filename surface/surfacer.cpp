@@ -1,5 +1,5 @@
-// The surfacer: particles -> level set -> mesh, with OpenVDB 10. This is the one file of Surge that includes
-// OpenVDB's tools (40-55 s to compile); everything else sees only surfacer.h.
+// The surfacer: particles -> level set -> mesh, with OpenVDB 10. With collider_clip.cpp, the one file of
+// surface/ that includes OpenVDB's tools (40-55 s to compile); everything else sees only surfacer.h.
 //
 // Method: a raw level set from particle_field.h (union of spheres, Zhu & Bridson blend or Yu & Turk
 // anisotropic kernels, by surface.method), smoothed by mean-curvature flow and eroded back to the fluid's
@@ -25,6 +25,7 @@
 #include "core/errors.h"
 #include "core/parallel.h"
 #include "surface/anisotropy.h"
+#include "surface/collider_clip.h"
 #include "surface/narrow_band.h"
 #include "surface/particle_field.h"
 #include "surface/vdb_output.h"
@@ -93,15 +94,19 @@ struct Parameters {
   std::string method;
 };
 
-Parameters resolve(const ParticleFrame& frame, const Scene& scene) {
+Parameters resolve(const Scene& scene, int dimensions) {
   Parameters p;
   p.spacing = scene.particle_spacing;
   if (!(p.spacing > 0)) throw RunError("surface: particle_spacing must be positive");
   p.radius = scene.surface.particle_radius > 0 ? scene.surface.particle_radius : p.spacing;
   p.voxel = scene.surface.voxel_size > 0 ? scene.surface.voxel_size : p.radius / 2;
-  p.layers = frame.dimensions == 2 ? 2 * kSlabHalfLayers + 1 : 1;
+  p.layers = dimensions == 2 ? 2 * kSlabHalfLayers + 1 : 1;
   p.method = scene.surface.method;
   return p;
+}
+
+Parameters resolve(const ParticleFrame& frame, const Scene& scene) {
+  return resolve(scene, frame.dimensions);
 }
 
 // The first particle more than 2^22 voxels from the origin on some axis, or -1: the blocks of 8^3 voxels are
@@ -209,6 +214,58 @@ double erosionOf(const Parameters& p) {
   return -kAnisoInset * p.spacing;
 }
 
+// Where the water meets a collider (collider_clip.h). The extension reaches as deep into the solid as the
+// erosion and the band could carry the end of the water back towards the wall, and a voxel more; it reads the
+// water half a spacing out of the solid (the centres of a layer resting on it), and for a method whose raw
+// surface lies under the fluid's face (anisotropic) also as much further out as that.
+ExtensionParameters extensionOf(const Parameters& p) {
+  ExtensionParameters e;
+  e.band = kHalfWidthVoxels * p.voxel;
+  e.depth = e.band + std::max(erosionOf(p), 0.0) + p.voxel;
+  e.near = 0.5 * p.spacing;
+  e.far = e.near + std::max(-erosionOf(p), 0.0);
+  return e;
+}
+
+// The colliders' level sets: on the fluid's side the water's band and a voxel, or the extension's reach there
+// and two voxels (its gradient); on the solid's, the extension's depth and band and two voxels. They are cut
+// to the tank with room for the extension's reach and a leaf, and in 2D to the water's slab.
+ColliderGrids colliderGrids(const Scene& scene) {
+  const Parameters p = resolve(scene, scene.dimensions);
+  const ExtensionParameters e = extensionOf(p);
+  ColliderGrids grids;
+  grids.voxel = p.voxel;
+  grids.fluid = float(std::max(kHalfWidthVoxels + 1, std::ceil(e.far / p.voxel) + 2));
+  grids.solid = float(std::ceil((e.depth + e.band) / p.voxel) + 2);
+  grids.output = float(kHalfWidthVoxels);
+  grids.flat = scene.dimensions == 2;
+  const double margin = (grids.solid + grids.fluid + kBlockDim) * p.voxel;
+  Eigen::Vector3d lo = scene.domain.min.array() - margin, hi = scene.domain.max.array() + margin;
+  if (grids.flat) {  // the slab and the VDB's band; the solid's band at z = 0 (the section used)
+    hi.z() =
+        std::max((kSlabHalfLayers + 0.5) * p.spacing + grids.output * p.voxel, (grids.solid + 1) * p.voxel);
+    lo.z() = -hi.z();
+  }
+  // A hand-made scene may have no tank: then the grids are cut only along z in 2D (never beyond the blocks'
+  // reach of 2^22 voxels, particle_field.h).
+  const double huge = double(1 << 22) * p.voxel;
+  for (int a = 0; a < (grids.flat ? 2 : 3); ++a)
+    if (!(scene.domain.max[a] > scene.domain.min[a])) lo[a] = -huge, hi[a] = huge;
+  grids.region = Eigen::AlignedBox3d(lo, hi);
+  return grids;
+}
+
+// The blocks of a grid's leaves, in the tree's order.
+BlockField blocksOf(const FloatGrid& grid) {
+  BlockField blocks;
+  for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
+    const openvdb::Coord o = leaf->origin();
+    blocks.origins.emplace_back(o.x(), o.y(), o.z());
+    blocks.values.insert(blocks.values.end(), leaf->buffer().data(), leaf->buffer().data() + kBlockVoxels);
+  }
+  return blocks;
+}
+
 // The level-set steps on NarrowBand: `firstIterations` Eikonal iterations (to make the field a distance, if
 // it is not one yet), smoothing, erosion, each followed by Eikonal iterations, then trimmed to the band. The
 // field's inside reaches deeper than the band by the erosion and a voxel more, so that the eroded band is
@@ -231,9 +288,15 @@ FloatGrid::Ptr smoothAndErode(BlockField blocks, const Parameters& p, int smooth
 // values are depths under the nearest sphere, not under the union, so never below -radius; the voxels beside
 // the zero crossing are exact distances to the union and are kept): one iteration per voxel of the inside's
 // depth, band + erosion + 1 voxel.
-FloatGrid::Ptr sphereLevelSet(const ParticleFrame& frame, const Parameters& p, int smoothingSteps) {
+FloatGrid::Ptr sphereLevelSet(const ParticleFrame& frame, const Parameters& p, int smoothingSteps,
+                              const std::vector<SurfaceCollider>& colliders) {
   BlockField raw = rawLevelSet(frame, p, kHalfWidthVoxels * p.voxel);
   Progress::checkInterrupt();
+  if (!colliders.empty()) {
+    const FloatGrid::Ptr grid = gridFromBlocks(raw, p.voxel, /*trim=*/false);
+    extendIntoColliders(*grid, colliders, extensionOf(p));
+    raw = blocksOf(*grid);
+  }
   const int iterations = int(std::ceil(kHalfWidthVoxels + std::max(erosionOf(p), 0.0) / p.voxel + 1));
   return smoothAndErode(std::move(raw), p, smoothingSteps, iterations);
 }
@@ -247,25 +310,20 @@ FloatGrid::Ptr sphereLevelSet(const ParticleFrame& frame, const Parameters& p, i
 // (the CFL steps of LevelSetFilter::offset, each re-distanced, smooth it as they dilate it).
 // (tools::sdfToSdf, fast sweeping, did the first re-distancing here once and took 85 s for a million
 // particles.)
-FloatGrid::Ptr blendedLevelSet(const ParticleFrame& frame, const Parameters& p, int smoothingSteps) {
+FloatGrid::Ptr blendedLevelSet(const ParticleFrame& frame, const Parameters& p, int smoothingSteps,
+                               const std::vector<SurfaceCollider>& colliders) {
   CtrlCInterrupter interrupter;
   FloatGrid::Ptr grid =
       gridFromBlocks(rawLevelSet(frame, p, kHalfWidthVoxels * p.voxel), p.voxel, /*trim=*/false);
   Progress::checkInterrupt();
+  if (!colliders.empty()) extendIntoColliders(*grid, colliders, extensionOf(p));
   openvdb::tools::LevelSetFilter<FloatGrid, FloatGrid, CtrlCInterrupter> filter(*grid, &interrupter);
   filter.setNormCount(kRenormalise);
   filter.normalize();
   filter.prune();  // voxels now beyond the band become inactive background
   Progress::checkInterrupt();
-  if (p.method == "smooth_spheres") {
-    BlockField blocks;
-    for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
-      const openvdb::Coord o = leaf->origin();
-      blocks.origins.emplace_back(o.x(), o.y(), o.z());
-      blocks.values.insert(blocks.values.end(), leaf->buffer().data(), leaf->buffer().data() + kBlockVoxels);
-    }
-    return smoothAndErode(std::move(blocks), p, smoothingSteps, /*firstIterations=*/0);
-  }
+  if (p.method == "smooth_spheres")
+    return smoothAndErode(blocksOf(*grid), p, smoothingSteps, /*firstIterations=*/0);
   // Anisotropic: 3 Eikonal iterations after each smoothing step (with one, the dilation below lost the block
   // 9% more; kRenormalise is still set), then the dilation in CFL steps, which grow the outer band as the
   // surface moves out.
@@ -280,7 +338,9 @@ FloatGrid::Ptr blendedLevelSet(const ParticleFrame& frame, const Parameters& p, 
 // (surface.smoothing_steps, default 2): enough to take out the bumps of the sphere union (on a flat face they
 // go from 0.04 to 0.004 spacings rms in two steps; each step moves the surface by a third of a voxel times
 // its curvature in voxels), few enough to keep edges and small droplets.
-FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
+// With colliders, the water is extended into them before the smoothing and clipped by them at the end.
+FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene,
+                             const std::vector<SurfaceCollider>& colliders = {}) {
   initOpenVdb();
   const Parameters p = resolve(frame, scene);
   if (frame.size() == 0) return emptyLevelSet(p.voxel);
@@ -294,8 +354,9 @@ FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene) {
     throw RunError("surface: particle " + std::to_string(far) +
                    " lies more than 2^22 voxels from the origin");
   const int steps = scene.surface.smoothing_steps;
-  FloatGrid::Ptr grid =
-      p.method == "spheres" ? sphereLevelSet(frame, p, steps) : blendedLevelSet(frame, p, steps);
+  FloatGrid::Ptr grid = p.method == "spheres" ? sphereLevelSet(frame, p, steps, colliders)
+                                              : blendedLevelSet(frame, p, steps, colliders);
+  if (!colliders.empty()) clipByColliders(*grid, colliders, double(grid->background()));
   Progress::checkInterrupt();
   return grid;
 }
@@ -393,12 +454,13 @@ void writeMeshObj(const fs::path& path, const TriangleMesh& mesh) {
   });
 }
 
-}  // namespace
-
-SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const fs::path& vdbPath,
-                          const fs::path& meshPath) {
-  const FloatGrid::Ptr grid = buildLevelSet(frame, scene);
-  const TriangleMesh mesh = meshLevelSet(*grid, scene.surface.adaptivity);
+// surfaceFrame, with the colliders as they stand at this frame: the water meets them (collider_clip.h) and
+// the VDB holds their level sets after the water's grids (planes have none: a half-space has no narrow band).
+SurfaceStats surfaceFrameWith(const ParticleFrame& frame, const Scene& scene, const fs::path& vdbPath,
+                              const fs::path& meshPath, const std::vector<SurfaceCollider>& colliders) {
+  const FloatGrid::Ptr grid = buildLevelSet(frame, scene, colliders);
+  TriangleMesh mesh = meshLevelSet(*grid, scene.surface.adaptivity);
+  if (!colliders.empty()) snapOutOfColliders(mesh, colliders, grid->voxelSize()[0]);
 
   const Parameters p = resolve(frame, scene);
   VdbExtras extras;
@@ -431,6 +493,8 @@ SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const 
     extras.pointVelocities = &v;
     extras.pointVoxel = 4 * p.spacing;  // about 64 particles per voxel of the points grid
   }
+  for (const SurfaceCollider& c : colliders)
+    if (c.output) extras.colliders.push_back(c.output);
   writeSurfaceVdb(vdbPath, grid, extras);
   writeMeshPly(meshPath, mesh);
   if (scene.surface.write_obj) {
@@ -444,6 +508,13 @@ SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const 
   stats.triangles = mesh.triangles.size();
   stats.voxelSize = grid->voxelSize()[0];
   return stats;
+}
+
+}  // namespace
+
+SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const fs::path& vdbPath,
+                          const fs::path& meshPath) {
+  return surfaceFrameWith(frame, scene, vdbPath, meshPath, {});
 }
 
 void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress,
@@ -462,10 +533,17 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
       std::vector<fs::path> outputs = {framePath(dir, "surface", f, "vdb"),
                                        framePath(dir, "surface", f, "ply")};
       if (scene.surface.write_obj) outputs.push_back(framePath(dir, "surface", f, "obj"));
-      return isUpToDate(outputs, {framePath(dir, "particles", f, "ply"), dir / "scene.json"});
+      std::vector<fs::path> inputs = {framePath(dir, "particles", f, "ply"), dir / "scene.json"};
+      for (const fs::path& file : colliderFrameFiles(dir, scene, f)) inputs.push_back(file);
+      return isUpToDate(outputs, inputs);
     };
     frames.erase(std::remove_if(frames.begin(), frames.end(), done), frames.end());
   }
+  // The colliders, the standing ones made level sets once here: none for a scene without colliders, nor
+  // when no frame is left to do.
+  const bool meet = !frames.empty() && !scene.colliders.empty();
+  const SurfaceColliders colliders(dir, meet ? scene.colliders : std::vector<ColliderSettings>(),
+                                   scene.particle_spacing, meet ? colliderGrids(scene) : ColliderGrids());
   progress.start("surface", frames.size());
   // Frames in parallel, one chunk each (OpenVDB's and our own loops inside a frame share the same oneTBB
   // workers). Each frame's files depend only on its particles, so the bytes are the same at any thread count.
@@ -481,8 +559,9 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
           if (const long far = farParticle(frame, resolve(frame, scene).voxel); far >= 0)
             throw InputError(path.string(), "vertex " + std::to_string(far),
                              "lies more than 2^22 voxels (surface.voxel_size) from the origin");
-          surfaceFrame(frame, scene, framePath(dir, "surface", f, "vdb"),
-                       framePath(dir, "surface", f, "ply"));
+          surfaceFrameWith(frame, scene, framePath(dir, "surface", f, "vdb"),
+                           framePath(dir, "surface", f, "ply"),
+                           colliders.empty() ? std::vector<SurfaceCollider>() : colliders.atFrame(f));
           const std::lock_guard<std::mutex> lock(advance);
           progress.advance();
         }

@@ -1,6 +1,7 @@
 // The surface stage: particle frames -> narrow-band level sets (OpenVDB) -> triangle meshes.
 //
-// Method (OpenVDB 10 in surfacer.cpp and vdb_output.cpp only, so that no other file pays for its headers):
+// Method (OpenVDB 10 in surfacer.cpp, collider_clip.cpp and vdb_output.cpp only, so that no other file pays
+// for its headers):
 //  1. A raw narrow-band level set of voxel size scene.surface.voxel_size and half-width 3 voxels, by
 //     scene.surface.method (particle_field.h, our own gather rasteriser, which never drops a particle):
 //     `spheres` (union of spheres of radius surface.particle_radius), `smooth_spheres` (Zhu & Bridson 2005),
@@ -14,6 +15,9 @@
 //  3. Mesh the zero crossing (tools::volumeToMesh), split quads into triangles, orient them outward and give
 //     each vertex the normalised level-set gradient as its normal.
 // 2D frames (z = 0) are extruded into a closed slab a few particles thick (see surfacer.cpp).
+// Where the scene has colliders (surfaceFrames, from dir/colliders/), the raw level set goes on into each
+// collider's solid before step 2 and is clipped by it after, and the mesh's vertices are kept out of it
+// (collider_clip.h): the water's surface lies on the collider's where they meet.
 #pragma once
 
 #include <cstddef>
@@ -35,15 +39,19 @@ struct SurfaceStats {
 // surface.write_velocity a vector grid "v", with surface.write_points a PointDataGrid "points" with attribute
 // "v") and meshPath (binary PLY with vertex normals; with surface.write_obj also an .obj beside it), each
 // atomically (temporary name in the same folder, then rename). Throws RunError if OpenVDB would drop a
-// particle (sphere under 1.5 voxels), Interrupted on Ctrl-C.
+// particle (sphere under 1.5 voxels), Interrupted on Ctrl-C. The scene's colliders are not used here.
 SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const fs::path& vdbPath,
                           const fs::path& meshPath);
 
 // The stage: for every dir/particles/frame_NNNNN.ply within range, writes dir/surface/frame_NNNNN.vdb and
 // dir/surface/frame_NNNNN.ply, frames in parallel (parallelFor, one frame a chunk: the same bytes at any
-// thread count). Reports progress per frame ("surface") and checks for Ctrl-C between frames. Throws
-// InputError naming dir if there is no particle frame (in range). With `resume`, a frame whose files are up
-// to date (isUpToDate against its particle frame and dir/scene.json) is left as it is.
+// thread count). With colliders in the scene, the water meets them (see above) and the VDB also holds their
+// level sets "collider_<name>" (all but planes; collider_clip.h); their meshes are read from
+// dir/colliders/<name>.ply, a moving one's from dir/colliders/<name>/frame_NNNNN.ply when present. Reports
+// progress per frame ("surface") and checks for Ctrl-C between frames. Throws InputError naming dir if there
+// is no particle frame (in range), naming the file if a collider's mesh is missing or bad. With `resume`, a
+// frame whose files are up to date (isUpToDate against its particle frame, dir/scene.json and the frame files
+// of its moving colliders) is left as it is.
 void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress,
                    bool resume = false);
 

@@ -59,7 +59,7 @@ openvdb::points::PointDataGrid::Ptr pointsGrid(const std::vector<Eigen::Vector3f
 }  // namespace
 
 void writeSurfaceVdb(const fs::path& path, const openvdb::FloatGrid::Ptr& surface, const VdbExtras& extras) {
-  openvdb::GridPtrVec grids{surface};
+  openvdb::GridCPtrVec grids{surface};
   if (extras.velocity) grids.push_back(velocityGrid(*extras.velocity, surface->transform()));
   if (extras.pointPositions && !extras.pointPositions->empty())
     grids.push_back(pointsGrid(*extras.pointPositions, *extras.pointVelocities, extras.pointVoxel));
@@ -69,6 +69,7 @@ void writeSurfaceVdb(const fs::path& path, const openvdb::FloatGrid::Ptr& surfac
     grid->setName("points");
     grids.push_back(grid);
   }
+  grids.insert(grids.end(), extras.colliders.begin(), extras.colliders.end());
 
   // openvdb::io::File writes to a path, not a stream, so the atomic write is done here: a temporary name in
   // the same folder (same file system, so the rename is atomic), then rename.

@@ -1,7 +1,8 @@
 // The VDB file of a surface frame, by Houdini's and Blender's conventions: the level set `surface` (grid class
 // level set), and on request a velocity grid `v` (a vector grid, vector type
 // contravariant-relative, as Houdini writes velocity fields) and the particles as a PointDataGrid `points` with a
-// float vector attribute `v`. Included only by surfacer.cpp (it pulls in OpenVDB's core headers).
+// float vector attribute `v`; after them the colliders' level sets `collider_<name>` (collider_clip.h).
+// Included only by surfacer.cpp (it pulls in OpenVDB's core headers).
 #pragma once
 
 #include <openvdb/openvdb.h>
@@ -19,6 +20,7 @@ struct VdbExtras {
   const std::vector<Eigen::Vector3f>* pointPositions = nullptr;
   const std::vector<Eigen::Vector3f>* pointVelocities = nullptr;
   double pointVoxel = 0;  // the points grid's voxel size
+  std::vector<openvdb::FloatGrid::ConstPtr> colliders;  // written as they are (named), after the others
 };
 
 // Writes the grids to `path` atomically (a temporary name in the same folder, then rename). Throws RunError.
