@@ -79,16 +79,8 @@ int main(int argc, char** argv) {
   PbfSolver<3> with(withMesh, shapes);
   {
     ParticleFrame initial = initialParticles(withMesh);
-    std::vector<Eigen::Vector3f> kept;
-    ParticleFrame frame;
-    for (size_t i = 0; i < initial.size(); ++i) {
-      Eigen::Vector3f normal;
-      if (with.colliders().distance(0, initial.position[i], normal) < 0.99f * with.colliders().particleRadius()) continue;
-      frame.position.push_back(initial.position[i]);
-      frame.velocity.push_back(initial.velocity[i]);
-      frame.id.push_back(uint32_t(frame.id.size()));
-    }
-    with.setParticles(frame);
+    removeParticlesInside(with.colliders(), initial);
+    with.setParticles(initial);
   }
   double time = 0;
   timeSteps(with, 24, time);  // settle a little: the water presses on the torus

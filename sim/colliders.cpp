@@ -218,7 +218,31 @@ size_t Colliders<Dim>::memoryBytes() const {
   return bytes;
 }
 
+template <int Dim>
+size_t removeParticlesInside(const Colliders<Dim>& colliders, ParticleFrame& frame) {
+  size_t kept = 0;
+  const float radius = 0.99f * colliders.particleRadius();  // a fluid box drawn against a wall keeps its layer
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const Vec<Dim> p = frame.position[i].head<Dim>();
+    bool inside = false;
+    for (size_t c = 0; c < colliders.size() && !inside; ++c) {
+      Vec<Dim> normal;
+      inside = colliders.distance(c, p, normal) < radius;
+    }
+    if (inside) continue;
+    frame.position[kept] = frame.position[i];
+    frame.velocity[kept] = frame.velocity[i];
+    frame.id[kept] = static_cast<uint32_t>(kept);
+    ++kept;
+  }
+  const size_t removed = frame.size() - kept;
+  frame.resize(kept);
+  return removed;
+}
+
 template class Colliders<2>;
 template class Colliders<3>;
+template size_t removeParticlesInside(const Colliders<2>&, ParticleFrame&);
+template size_t removeParticlesInside(const Colliders<3>&, ParticleFrame&);
 
 }  // namespace surge

@@ -22,6 +22,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/ply.h"
 #include "core/scene.h"
 #include "geometry/collider_shape.h"
 #include "sim/kernels.h"
@@ -165,6 +166,12 @@ class Colliders {
   bool hasFriction_ = false;
   std::vector<Wrench> slots_, extra_;
 };
+
+// Removes from `frame` the particles closer to a collider than 0.99 of their radius, with the colliders as
+// they are placed (at time 0 before the first step), renumbering the ids; returns how many were removed. A
+// fluid box drawn against a wall keeps its layer a radius from it.
+template <int Dim>
+size_t removeParticlesInside(const Colliders<Dim>& colliders, ParticleFrame& frame);
 
 // The tank and the colliders together, as the measures see them.
 template <int Dim>

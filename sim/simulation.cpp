@@ -103,29 +103,6 @@ float walkWhileContiguous(const std::vector<float>& sorted, size_t start, float 
                  formatVector(state.velocity[particle], state.dimensions) + " (not finite or outside the domain)");
 }
 
-// Removes the particles closer to a collider than their radius (as placed at time 0); returns how many.
-template <int Dim>
-size_t removeParticlesInside(const Colliders<Dim>& colliders, ParticleFrame& frame) {
-  size_t kept = 0;
-  const float radius = 0.99f * colliders.particleRadius();  // a fluid box drawn against a wall keeps its layer
-  for (size_t i = 0; i < frame.size(); ++i) {
-    const Vec<Dim> p = frame.position[i].head<Dim>();
-    bool inside = false;
-    for (size_t c = 0; c < colliders.size() && !inside; ++c) {
-      Vec<Dim> normal;
-      inside = colliders.distance(c, p, normal) < radius;
-    }
-    if (inside) continue;
-    frame.position[kept] = frame.position[i];
-    frame.velocity[kept] = frame.velocity[i];
-    frame.id[kept] = static_cast<uint32_t>(kept);
-    ++kept;
-  }
-  const size_t removed = frame.size() - kept;
-  frame.resize(kept);
-  return removed;
-}
-
 // One colliders.csv row a collider: the frame's mean force (N) and torque about the collider's position (N m).
 std::string colliderRows(const Scene& scene, int frame, const std::vector<Wrench>& wrenches) {
   std::string rows;
