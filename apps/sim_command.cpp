@@ -6,6 +6,7 @@
 #include "apps/commands.h"
 #include "core/errors.h"
 #include "core/parallel.h"
+#include "sim/rigid_bodies.h"
 #include "sim/simulation.h"
 
 namespace surge {
@@ -35,10 +36,12 @@ void checkResumable(const fs::path& previous, const std::string& previousJson, c
 }  // namespace
 
 void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const CommonOptions& options) {
-  // The colliders' files are read (and refused if bad) before anything is written.
+  // The colliders' and bodies' files are read (and refused if bad), and bodies overlapping at the start are
+  // refused, before anything is written.
   const std::shared_ptr<const ColliderShapes> shapes = buildColliderShapes(scene);
   for (const ColliderShape& shape : *shapes)
     if (!shape.note.empty()) say(options, "sim: " + shape.note);
+  if (!scene.bodies.empty()) RigidBodies check(scene, shapes);
   const std::string json = sceneToJson(scene);
   std::error_code error;
   const bool existing = fs::exists(dir / "scene.json", error);
@@ -59,7 +62,7 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   const SimulationSummary summary = simulate(scene, shapes, dir, resume, progress);
   if (summary.removedParticles > 0)
     say(options, "sim: removed " + std::to_string(summary.removedParticles) +
-                     " fluid particles placed inside colliders");
+                     " fluid particles placed inside " + (scene.bodies.empty() ? "colliders" : "colliders and bodies"));
   char line[256];
   std::snprintf(line, sizeof line, "sim: %zu particles, frames %d-%d in %.1f s -> %s/particles",
                 summary.particles, summary.firstFrame, summary.lastFrame, summary.wallSeconds,

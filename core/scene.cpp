@@ -355,31 +355,40 @@ void validateRotation(const Rotation& r, int dimensions, const std::string& wher
 }
 
 // What can be checked of the colliders without reading their files (geometry/collider_shape.cpp checks those).
-void validateColliders(Scene& s, const std::string& where) {
+// What colliders and bodies share: a unique plain name, a shape with the parameters it needs.
+void validateSolid(ColliderSettings& c, const std::string& key, const std::string& defaultName, int dimensions,
+                   std::set<std::string>& names, const std::string& where) {
+  if (c.name.empty()) c.name = defaultName;
+  if (!isPlainName(c.name))
+    throw InputError(where, key + ".name", "must be letters, digits, '-', '_' or '.', not starting with '.'");
+  if (!names.insert(c.name).second)
+    throw InputError(where, key + ".name", "'" + c.name + "' is used twice");
+  validateRotation(c.rotation, dimensions, where, key + ".rotation");
+  if (c.shape == "box") {
+    if (c.size.size() != size_t(dimensions))
+      throw InputError(where, key + ".size",
+                       "a box needs its full extents, " + std::to_string(dimensions) + " numbers");
+  } else if (c.shape == "heightfield") {
+    if (c.size.size() != 2) throw InputError(where, key + ".size", "a heightfield needs its [x, z] extents");
+  } else if (!c.size.empty()) {
+    throw InputError(where, key + ".size", "only a box or a heightfield has a size");
+  }
+  for (double extent : c.size)
+    if (!(extent > 0)) throw InputError(where, key + ".size", "extents must be > 0");
+  if ((c.shape == "heightfield" || c.shape == "mesh") && c.file.empty())
+    throw InputError(where, key + ".file", "a " + c.shape + " needs a file");
+  if (c.shape != "heightfield" && c.shape != "mesh" && !c.file.empty())
+    throw InputError(where, key + ".file", "only a heightfield or a mesh reads a file");
+}
+
+// What can be checked of the colliders and bodies without reading their files (geometry/collider_shape.cpp
+// checks those; sim/rigid_bodies.cpp checks that bodies do not overlap at the start).
+void validateSolids(Scene& s, const std::string& where) {
   std::set<std::string> names;
   for (size_t i = 0; i < s.colliders.size(); ++i) {
     ColliderSettings& c = s.colliders[i];
     const std::string key = "colliders[" + std::to_string(i) + "]";
-    if (c.name.empty()) c.name = "collider" + std::to_string(i);
-    if (!isPlainName(c.name))
-      throw InputError(where, key + ".name", "must be letters, digits, '-', '_' or '.', not starting with '.'");
-    if (!names.insert(c.name).second) throw InputError(where, key + ".name", "'" + c.name + "' is used twice");
-    validateRotation(c.rotation, s.dimensions, where, key + ".rotation");
-    if (c.shape == "box") {
-      if (c.size.size() != size_t(s.dimensions))
-        throw InputError(where, key + ".size", "a box needs its full extents, " + std::to_string(s.dimensions) +
-                                                   " numbers");
-    } else if (c.shape == "heightfield") {
-      if (c.size.size() != 2) throw InputError(where, key + ".size", "a heightfield needs its [x, z] extents");
-    } else if (!c.size.empty()) {
-      throw InputError(where, key + ".size", "only a box or a heightfield has a size");
-    }
-    for (double extent : c.size)
-      if (!(extent > 0)) throw InputError(where, key + ".size", "extents must be > 0");
-    if ((c.shape == "heightfield" || c.shape == "mesh") && c.file.empty())
-      throw InputError(where, key + ".file", "a " + c.shape + " needs a file");
-    if (c.shape != "heightfield" && c.shape != "mesh" && !c.file.empty())
-      throw InputError(where, key + ".file", "only a heightfield or a mesh reads a file");
+    validateSolid(c, key, "collider" + std::to_string(i), s.dimensions, names, where);
     if (c.shape == "plane") {
       if (!(c.normal.norm() > 0)) throw InputError(where, key + ".normal", "must not be the zero vector");
       if (c.container) throw InputError(where, key + ".container", "a plane cannot hold fluid; turn its normal");
@@ -390,6 +399,22 @@ void validateColliders(Scene& s, const std::string& where) {
       validateRotation(c.motion[k].rotation, s.dimensions, where, frameKey + ".rotation");
       if (k > 0 && c.motion[k].time < c.motion[k - 1].time)
         throw InputError(where, frameKey + ".time", "keyframes must be in time order");
+    }
+  }
+  for (size_t i = 0; i < s.bodies.size(); ++i) {
+    BodySettings& b = s.bodies[i];
+    const std::string key = "bodies[" + std::to_string(i) + "]";
+    validateSolid(b.solid, key, "body" + std::to_string(i), s.dimensions, names, where);
+    if (b.solid.shape == "mesh" && s.dimensions == 2)
+      throw InputError(where, key + ".shape", "a mesh body needs 3 dimensions");
+    if ((b.density > 0) == (b.mass > 0))
+      throw InputError(where, key + (b.density > 0 ? ".mass" : ".density"),
+                       "give a body its density or its mass (> 0), not both");
+    b.solid.thickness = s.particle_spacing;
+    if (s.dimensions == 2) {
+      // Motion in the plane: no z velocity, no spin but about z.
+      b.velocity.z() = 0;
+      b.angular_velocity.x() = b.angular_velocity.y() = 0;
     }
   }
 }
@@ -441,7 +466,7 @@ void validate(Scene& s, const std::string& where) {
     if (s.attractor.keyframes[i].time < s.attractor.keyframes[i - 1].time)
       throw InputError(where, "attractor.keyframes[" + std::to_string(i) + "].time", "keyframes must be in time order");
 
-  validateColliders(s, where);
+  validateSolids(s, where);
 
   SurfaceSettings& surface = s.surface;
   if (surface.particle_radius == 0) surface.particle_radius = spacing;
@@ -532,12 +557,22 @@ Scene parseScene(const std::string& text, const std::string& where, const std::v
   return scene;
 }
 
+std::vector<SolidFiles> solidFiles(const Scene& scene) {
+  std::vector<SolidFiles> solids;
+  for (const ColliderSettings& c : scene.colliders) solids.push_back({c, "colliders", c.motion.size() > 1});
+  for (const BodySettings& b : scene.bodies) solids.push_back({b.solid, "bodies", true});
+  return solids;
+}
+
 Scene loadScene(const fs::path& path, const std::vector<std::string>& overrides) {
   Scene scene = parseScene(readTextFile(path), path.string(), overrides);
-  // Collider files are named relative to the scene file; the resolved scene (scene.json) holds them absolute.
-  for (ColliderSettings& c : scene.colliders)
+  // Collider and body files are named relative to the scene file; the resolved scene (scene.json) holds them absolute.
+  auto resolve = [&](ColliderSettings& c) {
     if (!c.file.empty() && fs::path(c.file).is_relative())
       c.file = fs::absolute(path.parent_path() / c.file).lexically_normal().string();
+  };
+  for (ColliderSettings& c : scene.colliders) resolve(c);
+  for (BodySettings& b : scene.bodies) resolve(b.solid);
   return scene;
 }
 

@@ -95,6 +95,19 @@ struct ColliderSettings {
   int visible = 1;
 };
 
+// A rigid body in the water (sim/rigid_bodies.h): a solid of the colliders' vocabulary (a box, sphere, capsule,
+// cylinder or closed mesh, placed as a collider is) whose motion is computed from gravity, the fluid's force and
+// torque, and contacts with the other bodies, the colliders and the tank. `solid.friction` is the Coulomb
+// coefficient of its contacts (the fluid slides freely along it).
+struct BodySettings {
+  ColliderSettings solid;
+  double density = 0;  // kg/m^3 (kg/m^2 in 2D, as the fluid's); 0: from mass
+  double mass = 0;     // kg (kg/m in 2D); 0: from density
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // rad/s, about the centre of mass (z in 2D)
+  double restitution = 0.1;
+};
+
 struct OutputSettings {
   double fps = 30;
   int frames = 90;
@@ -144,6 +157,7 @@ struct Scene {
   Eigen::Vector3d gravity = Eigen::Vector3d(0, -9.81, 0);
   AttractorSettings attractor;
   std::vector<ColliderSettings> colliders;
+  std::vector<BodySettings> bodies;
   SolverSettings solver;
   OutputSettings output;
   SurfaceSettings surface;
@@ -155,6 +169,16 @@ struct Scene {
   // Particles the fluid boxes hold on the lattice of particle_spacing.
   size_t particleCount() const;
 };
+
+// A collider or a body as the simulation left it for the later stages: its mesh in the world at time 0 in
+// <folder>/<name>.ply and, when it moves (keyframes, or a body), at each frame in <folder>/<name>/frame_NNNNN.ply.
+struct SolidFiles {
+  ColliderSettings settings;  // a body's solid settings
+  std::string folder;         // "colliders" or "bodies", under the output folder
+  bool moving = false;
+};
+// The scene's colliders, then its bodies.
+std::vector<SolidFiles> solidFiles(const Scene& scene);
 
 // Lattice points of one fluid box: counts per axis (1 on unused axes in 2D).
 Eigen::Array3i latticeCounts(const Scene& scene, const Box& box);

@@ -43,42 +43,78 @@ void visitRotation(SceneVisitor& v, Rotation& r) {
   });
 }
 
-void visitCollider(SceneVisitor& v, ColliderSettings& c) {
-  v.text("name", c.name, info("a name for colliders.csv and the output meshes (letters, digits, -, _); empty: "
-                              "collider<i>"));
-  v.choice("shape", c.shape, {"plane", "box", "sphere", "capsule", "cylinder", "heightfield", "mesh"},
-           required("plane (a half-space), box, sphere, capsule and cylinder (along local y), heightfield (a "
-                    "greyscale PNG; the fluid stays above), mesh (OBJ or PLY)"));
+// The keys colliders and bodies share: a shape, its placement, its look. A body takes no plane or heightfield,
+// its friction is its contacts' and its name defaults to body<i>.
+void visitSolid(SceneVisitor& v, ColliderSettings& c, bool body) {
+  v.text("name", c.name,
+         body ? info("a name for bodies.csv and the output meshes (letters, digits, -, _, .); empty: body<i>")
+              : info("a name for colliders.csv and the output meshes (letters, digits, -, _, .); empty: "
+                     "collider<i>"));
+  if (body)
+    v.choice("shape", c.shape, {"box", "sphere", "capsule", "cylinder", "mesh"},
+             required("box, sphere, capsule and cylinder (along local y), mesh (a closed OBJ or PLY; 3D only)"));
+  else
+    v.choice("shape", c.shape, {"plane", "box", "sphere", "capsule", "cylinder", "heightfield", "mesh"},
+             required("plane (a half-space), box, sphere, capsule and cylinder (along local y), heightfield (a "
+                      "greyscale PNG; the fluid stays above), mesh (OBJ or PLY)"));
   v.vector("position", c.position,
-           info("the shape's centre; a point on a plane; the centre of a heightfield's base (black)", "m"));
+           body ? info("where the shape's centre (a mesh's origin) starts", "m")
+                : info("the shape's centre; a point on a plane; the centre of a heightfield's base (black)", "m"));
   visitRotation(v, c.rotation);
   v.real("scale", c.scale, positive("uniform scale of the shape about its position"));
-  v.integer("container", c.container,
-            atLeast(0, "1: the fluid is held inside the shape (a bowl, a glass) instead of kept out", "", 1));
-  v.reals("size", c.size, info("box: full extents (a vector); heightfield: [x, z] extents", "m"));
+  if (!body)
+    v.integer("container", c.container,
+              atLeast(0, "1: the fluid is held inside the shape (a bowl, a glass) instead of kept out", "", 1));
+  v.reals("size", c.size,
+          info(body ? "box: full extents (a vector)" : "box: full extents (a vector); heightfield: [x, z] extents",
+               "m"));
   v.real("radius", c.radius, positive("sphere, capsule and cylinder radius", "m"));
   v.real("height", c.height,
-         positive("capsule and cylinder: length along local y (a capsule's without its caps); heightfield: the "
-                  "height of white",
+         positive(body ? "capsule and cylinder: length along local y (a capsule's without its caps)"
+                       : "capsule and cylinder: length along local y (a capsule's without its caps); heightfield: "
+                         "the height of white",
                   "m"));
-  v.vector("normal", c.normal, info("plane: the normal, pointing into the fluid (any length but 0)"));
-  v.text("file", c.file, info("heightfield: a PNG (8 or 16 bit grey); mesh: an OBJ or PLY; relative to the scene file"));
-  v.real("thickness", c.thickness,
-         atLeast(0, "mesh: the shell thickness given to an open or non-manifold mesh; 0 means particle_spacing", "m"));
-  v.list(
-      "motion", info("keyframes of position and rotation, linearly interpolated (held before the first and after "
-                     "the last); empty: the collider stands still"),
-      [&] { return c.motion.size(); }, [&](size_t n) { c.motion.resize(n); },
-      [&](size_t i) {
-        v.real("time", c.motion[i].time, atLeast(0, "time of the keyframe", "s"));
-        v.vector("position", c.motion[i].position, required("position at that time", "m"));
-        visitRotation(v, c.motion[i].rotation);
-      });
-  v.real("friction", c.friction,
-         atLeast(0, "the fraction of the fluid's sliding velocity along the wall taken away over each 1/30 s of "
-                    "contact: 0 free slip, 1 no slip", "", 1));
+  if (!body)
+    v.vector("normal", c.normal, info("plane: the normal, pointing into the fluid (any length but 0)"));
+  v.text("file", c.file,
+         body ? info("mesh: a closed OBJ or PLY, relative to the scene file")
+              : info("heightfield: a PNG (8 or 16 bit grey); mesh: an OBJ or PLY; relative to the scene file"));
+  if (!body) {
+    v.real("thickness", c.thickness,
+           atLeast(0, "mesh: the shell thickness given to an open or non-manifold mesh; 0 means particle_spacing",
+                   "m"));
+    v.list(
+        "motion", info("keyframes of position and rotation, linearly interpolated (held before the first and "
+                       "after the last); empty: the collider stands still"),
+        [&] { return c.motion.size(); }, [&](size_t n) { c.motion.resize(n); },
+        [&](size_t i) {
+          v.real("time", c.motion[i].time, atLeast(0, "time of the keyframe", "s"));
+          v.vector("position", c.motion[i].position, required("position at that time", "m"));
+          visitRotation(v, c.motion[i].rotation);
+        });
+  }
+  if (body)
+    v.real("friction", c.friction,
+           atLeast(0, "Coulomb friction coefficient of its contacts with bodies, colliders and the tank"));
+  else
+    v.real("friction", c.friction,
+           atLeast(0, "the fraction of the fluid's sliding velocity along the wall taken away over each 1/30 s of "
+                      "contact: 0 free slip, 1 no slip", "", 1));
   v.vector("color", c.color, atLeast(0, "linear RGB albedo in the renders", "", 1), true);
   v.integer("visible", c.visible, atLeast(0, "0: simulated but not drawn", "", 1));
+}
+
+void visitBody(SceneVisitor& v, BodySettings& b) {
+  visitSolid(v, b.solid, true);
+  v.real("density", b.density,
+         atLeast(0, "mass per volume (per area in 2D, like the fluid's rest_density); give density or mass",
+                 "kg/m^3"));
+  v.real("mass", b.mass, atLeast(0, "the body's mass (per metre of depth in 2D); give density or mass", "kg"));
+  v.vector("velocity", b.velocity, info("initial velocity of the centre of mass", "m/s"));
+  v.vector("angular_velocity", b.angular_velocity,
+           info("initial angular velocity (3 components also in 2D, where only z counts)", "rad/s"), true);
+  v.real("restitution", b.restitution,
+         atLeast(0, "bounce of its contacts: 0 none, 1 elastic", "", 1));
 }
 
 }  // namespace
@@ -119,7 +155,12 @@ void visitScene(Scene& s, SceneVisitor& v) {
   v.list(
       "colliders", info("obstacles and containers the fluid meets (the tank's walls are always there)"),
       [&] { return s.colliders.size(); }, [&](size_t n) { s.colliders.resize(n); },
-      [&](size_t i) { visitCollider(v, s.colliders[i]); });
+      [&](size_t i) { visitSolid(v, s.colliders[i], false); });
+  v.list(
+      "bodies", info("rigid bodies the fluid carries and pushes, and that collide with each other, the colliders "
+                     "and the tank (Bullet)"),
+      [&] { return s.bodies.size(); }, [&](size_t n) { s.bodies.resize(n); },
+      [&](size_t i) { visitBody(v, s.bodies[i]); });
 
   v.group("solver", info("the simulator"), [&] {
     v.choice("method", s.solver.method, {"pbf", "wcsph"},

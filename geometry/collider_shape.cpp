@@ -140,9 +140,15 @@ bool isClosedManifold(const TriangleMesh& mesh) {
 }
 
 ColliderShape buildColliderShape(const Scene& scene, size_t index) {
-  const ColliderSettings& c = scene.colliders.at(index);
+  return buildSolidShape(scene, scene.colliders.at(index), "colliders[" + std::to_string(index) + "]", false);
+}
+
+ColliderShape buildBodyShape(const Scene& scene, size_t index) {
+  return buildSolidShape(scene, scene.bodies.at(index).solid, "bodies[" + std::to_string(index) + "]", true);
+}
+
+ColliderShape buildSolidShape(const Scene& scene, const ColliderSettings& c, const std::string& key, bool body) {
   const std::string where = scene.source.empty() ? "scene" : scene.source;
-  const std::string key = "colliders[" + std::to_string(index) + "]";
   const float spacing = float(scene.particle_spacing);
   const float support = float(scene.solver.kernel_radius > 0 ? scene.solver.kernel_radius : 2 * spacing);
   const Vec3 domainExtent = (scene.domain.max - scene.domain.min).cast<float>();
@@ -208,6 +214,9 @@ ColliderShape buildColliderShape(const Scene& scene, size_t index) {
       throw InputError(where, key + ".file",
                        "the mesh's distance grid would need " + std::to_string(int(bytes / 1e9)) +
                            " GB at a voxel of half particle_spacing; scale the mesh down or coarsen the spacing");
+    if (!closed && body)
+      throw InputError(where, key + ".file",
+                       "'" + c.file + "' is open or non-manifold: a body needs a closed mesh for its volume");
     if (!closed) {
       char line[256];
       std::snprintf(line, sizeof line, "is open or non-manifold: treated as a shell %.4g m thick", c.thickness);
@@ -241,6 +250,11 @@ ColliderShape buildColliderShape(const Scene& scene, size_t index) {
     }
     if (!isMoving(c) && !world.intersects(domain))
       throw InputError(where, key, "lies entirely outside the domain");
+    // A body starts inside the tank (its box may reach past a wall by less than a particle radius).
+    const double slack = 0.5 * scene.particle_spacing;
+    for (int k = 0; body && k < scene.dimensions; ++k)
+      if (world.min()[k] < domain.min()[k] - slack || world.max()[k] > domain.max()[k] + slack)
+        throw InputError(where, key + ".position", "the body must start inside the domain");
   }
   return s;
 }

@@ -57,6 +57,11 @@ class ColliderShape {
 // and the key: a missing or unreadable file, a mesh without triangles, a distance grid too large, a collider
 // entirely outside the domain.
 ColliderShape buildColliderShape(const Scene& scene, size_t index);
+// Body `index` likewise; a body's mesh must be closed, and the body must start inside the domain.
+ColliderShape buildBodyShape(const Scene& scene, size_t index);
+// Either, from its settings; `key` ("colliders[2]") names it in errors.
+ColliderShape buildSolidShape(const Scene& scene, const ColliderSettings& settings, const std::string& key,
+                              bool body);
 
 // True if every edge of the mesh is shared by exactly two triangles (a closed, manifold surface).
 bool isClosedManifold(const TriangleMesh& mesh);

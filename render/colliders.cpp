@@ -24,7 +24,7 @@ std::vector<Eigen::Vector3f> facingNormals(const TriangleMesh& mesh) {
 TriangleMesh readColliderMesh(const fs::path& path) {
   std::error_code error;
   if (!fs::exists(path, error))
-    throw InputError(path.string(), "missing: the simulation writes colliders/; run surge sim again");
+    throw InputError(path.string(), "missing: the simulation writes colliders/ and bodies/; run surge sim again");
   return readMeshPly(path);
 }
 
@@ -61,21 +61,23 @@ std::vector<std::array<uint32_t, 3>> trianglesFacing(const ColliderMesh& collide
   return kept;
 }
 
-ColliderMeshes::ColliderMeshes(const fs::path& dir, const Scene& scene) : folder_(dir / "colliders") {
-  for (const ColliderSettings& settings : scene.colliders)
-    if (settings.visible) visible_.push_back(settings);
-  for (const ColliderSettings& settings : visible_)
-    meshes_.push_back(makeColliderMesh(settings, readColliderMesh(folder_ / (settings.name + ".ply"))));
+ColliderMeshes::ColliderMeshes(const fs::path& dir, const Scene& scene) : dir_(dir) {
+  for (const SolidFiles& solid : solidFiles(scene))
+    if (solid.settings.visible) visible_.push_back(solid);
+  for (const SolidFiles& solid : visible_)
+    meshes_.push_back(
+        makeColliderMesh(solid.settings, readColliderMesh(dir_ / solid.folder / (solid.settings.name + ".ply"))));
 }
 
 const std::vector<ColliderMesh>& ColliderMeshes::atFrame(int frame) {
   if (frame == loadedFrame_) return meshes_;
   for (size_t c = 0; c < visible_.size(); ++c) {
-    if (visible_[c].motion.size() <= 1) continue;  // standing still: read once by the constructor
+    const SolidFiles& solid = visible_[c];
+    if (!solid.moving) continue;  // standing still: read once by the constructor
     std::error_code error;
-    fs::path path = framePath(folder_, visible_[c].name, frame, "ply");
-    if (!fs::exists(path, error)) path = folder_ / (visible_[c].name + ".ply");
-    meshes_[c] = makeColliderMesh(visible_[c], readColliderMesh(path));
+    fs::path path = framePath(dir_ / solid.folder, solid.settings.name, frame, "ply");
+    if (!fs::exists(path, error)) path = dir_ / solid.folder / (solid.settings.name + ".ply");
+    meshes_[c] = makeColliderMesh(solid.settings, readColliderMesh(path));
   }
   loadedFrame_ = frame;
   return meshes_;
@@ -83,10 +85,10 @@ const std::vector<ColliderMesh>& ColliderMeshes::atFrame(int frame) {
 
 std::vector<fs::path> ColliderMeshes::frameFiles(int frame) const {
   std::vector<fs::path> files;
-  for (const ColliderSettings& settings : visible_) {
+  for (const SolidFiles& solid : visible_) {
     std::error_code error;
-    const fs::path path = framePath(folder_, settings.name, frame, "ply");
-    if (settings.motion.size() > 1 && fs::exists(path, error)) files.push_back(path);
+    const fs::path path = framePath(dir_ / solid.folder, solid.settings.name, frame, "ply");
+    if (solid.moving && fs::exists(path, error)) files.push_back(path);
   }
   return files;
 }

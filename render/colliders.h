@@ -39,8 +39,9 @@ ColliderMesh makeColliderMesh(const ColliderSettings& settings, TriangleMesh mes
 std::vector<std::array<uint32_t, 3>> trianglesFacing(const ColliderMesh& collider,
                                                      const Eigen::Vector3f& camera);
 
-// The visible colliders of an output folder, frame by frame: the standing ones are read once, a moving one's
-// mesh at every frame (its <name>.ply when that frame's file is missing).
+// The visible colliders and bodies of an output folder (core/scene.h's solidFiles), frame by frame: the
+// standing ones are read once, a moving one's mesh at every frame (its <name>.ply when that frame's file is
+// missing).
 class ColliderMeshes {
  public:
   // Reads the standing colliders' meshes. Throws InputError naming the file if one is missing or unreadable.
@@ -53,8 +54,8 @@ class ColliderMeshes {
   std::vector<fs::path> frameFiles(int frame) const;
 
  private:
-  fs::path folder_;
-  std::vector<ColliderSettings> visible_;
+  fs::path dir_;
+  std::vector<SolidFiles> visible_;
   std::vector<ColliderMesh> meshes_;  // one per visible collider
   int loadedFrame_ = -1;
 };

@@ -16,7 +16,7 @@ packages=(
   libeigen3-dev libtbb-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libopenvdb-dev libboost-iostreams-dev libopenvdb-tools
   libembree-dev libosmesa6-dev libstb-dev libtinyobjloader-dev
-  libgtest-dev libbenchmark-dev ffmpeg gnuplot-nox zlib1g-dev
+  libgtest-dev libbenchmark-dev ffmpeg gnuplot-nox zlib1g-dev libbullet-dev
 )
 
 missing=()

@@ -10,6 +10,7 @@ namespace surge {
 std::shared_ptr<const ColliderShapes> buildColliderShapes(const Scene& scene) {
   auto shapes = std::make_shared<ColliderShapes>();
   for (size_t i = 0; i < scene.colliders.size(); ++i) shapes->push_back(buildColliderShape(scene, i));
+  for (size_t i = 0; i < scene.bodies.size(); ++i) shapes->push_back(buildBodyShape(scene, i));
   return shapes;
 }
 
@@ -17,18 +18,46 @@ template <int Dim>
 Colliders<Dim>::Colliders(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes,
                           const TankWalls<Dim>& tank)
     : shapes_(std::move(shapes)), settings_(scene.colliders), tank_(&tank) {
-  if (!shapes_ && !scene.colliders.empty()) shapes_ = buildColliderShapes(scene);
+  if (!shapes_ && hasSolids(scene)) shapes_ = buildColliderShapes(scene);
+  firstBody_ = settings_.size();
+  for (const BodySettings& b : scene.bodies) {
+    settings_.push_back(b.solid);
+    settings_.back().friction = 0;  // a body's friction is its contacts'; the fluid slides along it
+    bodyStart_.push_back(colliderPose(b.solid, 0.0));
+  }
+  bodyEnd_ = bodyStart_;
+  bodyCentre_.assign(scene.bodies.size(), Eigen::Vector3d::Zero());
   support_ = static_cast<float>(scene.solver.kernel_radius);
   radius_ = static_cast<float>(0.5 * scene.particle_spacing);
   placed_.resize(settings_.size());
   extra_.assign(settings_.size(), Wrench{});
+  stepMark_ = extra_;
   for (size_t c = 0; c < placed_.size(); ++c) {
     placed_[c].shape = &(*shapes_)[c];
     placed_[c].friction = static_cast<float>(settings_[c].friction);
-    placed_[c].moving = isMoving(settings_[c]);
+    placed_[c].moving = isMoving(settings_[c]) || c >= firstBody_;
     hasFriction_ = hasFriction_ || settings_[c].friction > 0;
   }
   beginStep(0.0, 0.0f);
+}
+
+template <int Dim>
+void Colliders<Dim>::setBodyPose(size_t body, const Pose& pose, const Eigen::Vector3d& centreOfMass) {
+  bodyStart_[body] = bodyEnd_[body];
+  bodyEnd_[body] = pose;
+  bodyCentre_[body] = centreOfMass;
+}
+
+template <int Dim>
+std::vector<Wrench> Colliders<Dim>::takeStepWrenches(double dt) {
+  addWrenches(takeSlotSums(), 1.0);
+  std::vector<Wrench> step(extra_.size());
+  for (size_t c = 0; c < extra_.size(); ++c) {
+    step[c].force = (extra_[c].force - stepMark_[c].force) / dt;
+    step[c].torque = (extra_[c].torque - stepMark_[c].torque) / dt;
+  }
+  stepMark_ = extra_;
+  return step;
 }
 
 template <int Dim>
@@ -37,8 +66,9 @@ void Colliders<Dim>::beginStep(double time, float dt) {
   for (size_t c = 0; c < placed_.size(); ++c) {
     Placed& k = placed_[c];
     const ColliderShape& shape = *k.shape;
-    const Pose end = colliderPose(settings_[c], time + dt);
-    const Pose start = k.moving ? colliderPose(settings_[c], time) : end;
+    const bool body = c >= firstBody_;
+    const Pose end = body ? bodyEnd_[c - firstBody_] : colliderPose(settings_[c], time + dt);
+    const Pose start = body ? bodyStart_[c - firstBody_] : k.moving ? colliderPose(settings_[c], time) : end;
     k.rotation = end.rotation.toRotationMatrix().cast<float>();
     k.translation = end.translation.cast<float>();
     k.previousRotation = start.rotation.toRotationMatrix().cast<float>();
@@ -48,7 +78,9 @@ void Colliders<Dim>::beginStep(double time, float dt) {
     // means the same at any number of substeps: over a step dt, 1 - (1 - friction)^(dt / kFrictionTime).
     k.frictionThisStep =
         k.friction >= 1 ? 1.0f : static_cast<float>(1 - std::pow(1.0 - k.friction, double(dt) / kFrictionTime));
-    k.centre = k.translation.template head<Dim>();
+    // Torques are about a collider's position, a body's centre of mass.
+    k.centre = body ? Vec<Dim>(bodyCentre_[c - firstBody_].cast<float>().template head<Dim>())
+                    : Vec<Dim>(k.translation.template head<Dim>());
     // The near box: the shape's box at both ends of the step, grown by the support. A plane and a container
     // reach everywhere.
     constexpr float kEverywhere = std::numeric_limits<float>::infinity();
@@ -194,6 +226,7 @@ std::vector<Wrench> Colliders<Dim>::takeFrameWrenches(double duration) {
     w.torque /= duration;
   }
   extra_.assign(placed_.size(), Wrench{});
+  stepMark_ = extra_;
   return total;
 }
 

@@ -12,7 +12,9 @@
 //  - the force and torque the fluid exerts on each collider: every impulse a collider gives a particle is
 //    summed per collider, per chunk of 1024 particles (so the sums are the same at any thread count), and
 //    turned into the frame's mean force and torque for colliders.csv.
-// A scene without colliders has an empty Colliders: every call returns at once.
+// A rigid body (sim/rigid_bodies.h) is a collider whose pose is set each step (setBodyPose) rather than
+// scripted; the scene's colliders come first, then its bodies (bodyIndex).
+// A scene without colliders or bodies has an empty Colliders: every call returns at once.
 //
 // The tank is the box container that every scene has; it stays in TankWalls, whose edges and corners are
 // tabulated exactly, and Boundary below adds the two for the solvers.
@@ -25,6 +27,7 @@
 #include "core/ply.h"
 #include "core/scene.h"
 #include "geometry/collider_shape.h"
+#include "geometry/pose.h"
 #include "sim/kernels.h"
 #include "sim/tank.h"
 
@@ -34,10 +37,14 @@ struct Wrench {
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
 };
 
+// The shapes of the scene's colliders, then of its bodies, in the scene's order.
 using ColliderShapes = std::vector<ColliderShape>;
 
-// Builds every collider shape of the scene (reads files, bakes mesh distances); InputError on bad input.
+// Builds every collider and body shape of the scene (reads files, bakes mesh distances); InputError on bad input.
 std::shared_ptr<const ColliderShapes> buildColliderShapes(const Scene& scene);
+
+// True if the scene has colliders or bodies: the fluid meets solids other than the tank.
+inline bool hasSolids(const Scene& scene) { return !scene.colliders.empty() || !scene.bodies.empty(); }
 
 template <int Dim>
 class Colliders {
@@ -58,6 +65,12 @@ class Colliders {
   // over the step.
   void beginStep(double time, float dt);
 
+  // Bodies: solid firstBody() + b is body b. setBodyPose gives body b's pose at the end of the coming step (its
+  // pose at the step's start is the one given before) and its centre of mass there, about which its torque is
+  // summed.
+  size_t firstBody() const { return firstBody_; }
+  void setBodyPose(size_t body, const Pose& pose, const Eigen::Vector3d& centreOfMass);
+
   // Calls visit(c, distance, normal) for every collider whose surface is within the kernel support of p.
   template <typename Visit>
   void forEachNear(const VecD& p, Visit&& visit) const {
@@ -77,6 +90,18 @@ class Colliders {
     weight = w;
     gradient = -g * n;
     tank_->subtractOverlap(p, d, n, weight, gradient);
+  }
+
+  // WCSPH's pressure in the wall, continued from the particle's own by the hydrostatic gradient (Adami, Hu and
+  // Adams 2012, eq. 27, without the wall's acceleration): p_b = p_i + rho_i g . (x_b - x_i). Returns
+  // sum_b (g . (x_b - x_i)) grad W(x_i - x_b) over the flat wall at d along n; the wall's push on the particle
+  // gains -m / rho_i times it. Mirroring p_i alone (p_b = p_i) pushes too hard on a particle below a wall and
+  // too softly above one: a ball under water read 27% over Archimedes in 3D (docs/colliders.md).
+  VecD hydrostaticSum(float d, const VecD& n, const VecD& g) const {
+    float normal, tangent;
+    tank_->flatWall().moments(d, normal, tangent);
+    const float gn = g.dot(n);
+    return -(gn * normal) * n - tangent * (g - gn * n);
   }
 
   // Adds every collider's share of the density sums at p (as TankWalls::add does for the tank).
@@ -133,6 +158,9 @@ class Colliders {
     w.torque -= r.cross(j);
   }
   std::vector<Wrench> takeFrameWrenches(double duration);
+  // Every solid's mean force and torque over the step of length dt just taken (the bodies' coupling); the
+  // frame's sums go on.
+  std::vector<Wrench> takeStepWrenches(double dt);
   // The slots summed per collider (in slot order) and cleared: for a solver that records forces rather than
   // impulses (WCSPH), which then adds them times their time span with addWrenches.
   std::vector<Wrench> takeSlotSums();
@@ -164,7 +192,10 @@ class Colliders {
   const TankWalls<Dim>* tank_ = nullptr;
   float support_ = 0, radius_ = 0, dt_ = 1;
   bool hasFriction_ = false;
-  std::vector<Wrench> slots_, extra_;
+  std::vector<Wrench> slots_, extra_, stepMark_;
+  size_t firstBody_ = 0;
+  std::vector<Pose> bodyStart_, bodyEnd_;
+  std::vector<Eigen::Vector3d> bodyCentre_;
 };
 
 // Removes from `frame` the particles closer to a collider than 0.99 of their radius, with the colliders as

@@ -37,7 +37,7 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
              static_cast<float>(scene.solver.kernel_radius),
              [&](const VecD& r) { return kernels_.poly6(r.squaredNorm()); },
              [&](const VecD& r) { return kernels_.spikyGradient(r, r.norm()); }) {
-  if (!scene.colliders.empty()) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
+  if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
   substeps_ = scene.solver.substeps;
   const SolverSettings& s = scene.solver;
   const float spacing = static_cast<float>(scene.particle_spacing);

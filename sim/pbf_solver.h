@@ -63,6 +63,7 @@ class PbfSolver {
   // Each collider's mean force and torque from the fluid since the last call, over `duration` seconds.
   std::vector<Wrench> takeColliderWrenches(double duration) { return colliders_.takeFrameWrenches(duration); }
   const Colliders<Dim>& colliders() const { return colliders_; }
+  Colliders<Dim>& colliders() { return colliders_; }  // the bodies' coupling sets their poses here
   // Bytes held by every particle channel, the grid, the neighbour lists and the pair factors (capacities).
   size_t memoryBytes() const;
 

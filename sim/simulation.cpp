@@ -10,6 +10,7 @@
 #include "core/errors.h"
 #include "geometry/pose.h"
 #include "sim/pbf_solver.h"
+#include "sim/rigid_bodies.h"
 #include "sim/wcsph_solver.h"
 
 namespace surge {
@@ -132,7 +133,7 @@ void writeColliderMeshes(const Scene& scene, const ColliderShapes& shapes, const
   std::error_code error;
   if (!resume) fs::remove_all(folder, error);
   fs::create_directories(folder);
-  for (size_t c = 0; c < shapes.size(); ++c) {
+  for (size_t c = 0; c < scene.colliders.size(); ++c) {
     writeMeshPly(folder / (scene.colliders[c].name + ".ply"), placedMesh(scene.colliders[c], shapes[c], 0.0));
     if (isMoving(scene.colliders[c])) {
       fs::create_directories(folder / scene.colliders[c].name);
@@ -144,10 +145,48 @@ void writeColliderMeshes(const Scene& scene, const ColliderShapes& shapes, const
 
 // colliders/<name>/frame_NNNNN.ply: a moving collider's mesh at each frame.
 void writeMovingColliderMeshes(const Scene& scene, const ColliderShapes& shapes, const fs::path& dir, int frame) {
-  for (size_t c = 0; c < shapes.size(); ++c)
+  for (size_t c = 0; c < scene.colliders.size(); ++c)
     if (isMoving(scene.colliders[c]))
       writeMeshPly(framePath(dir / "colliders", scene.colliders[c].name, frame, "ply"),
                    placedMesh(scene.colliders[c], shapes[c], frame / scene.output.fps));
+}
+
+// One bodies.csv row a body: its state at the frame's end and the fluid's mean wrench on it over the frame.
+std::string bodyRows(const Scene& scene, int frame, const std::vector<BodyState>& states,
+                     const std::vector<Wrench>& wrenches) {
+  std::string rows;
+  for (size_t b = 0; b < states.size(); ++b) {
+    const BodyState& s = states[b];
+    const Wrench& w = wrenches[b];
+    char row[768];
+    std::snprintf(row, sizeof row,
+                  "%d,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g",
+                  frame, scene.bodies[b].solid.name.c_str(), s.position.x(), s.position.y(), s.position.z(),
+                  s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z(), s.velocity.x(),
+                  s.velocity.y(), s.velocity.z(), s.angularVelocity.x(), s.angularVelocity.y(),
+                  s.angularVelocity.z(), w.force.x(), w.force.y(), w.force.z(), w.torque.x(), w.torque.y(),
+                  w.torque.z());
+    rows += (rows.empty() ? "" : "\n") + std::string(row);
+  }
+  return rows;
+}
+
+// bodies/<name>/frame_NNNNN.ply: each body's mesh in the world at the frame (and bodies/<name>.ply at frame 0),
+// and bodies/frame_NNNNN.txt, the exact state a resumed run starts from.
+void writeBodyFrame(const Scene& scene, const ColliderShapes& shapes, const RigidBodies& bodies,
+                    const fs::path& dir, int frame) {
+  const fs::path folder = dir / "bodies";
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    const Pose pose = bodies.pose(b);
+    TriangleMesh mesh = shapes[scene.colliders.size() + b].mesh;
+    for (Eigen::Vector3f& p : mesh.positions) p = pose.toWorld(p.cast<double>()).cast<float>();
+    for (Eigen::Vector3f& n : mesh.normals) n = (pose.rotation * n.cast<double>()).cast<float>();
+    const std::string& name = scene.bodies[b].solid.name;
+    fs::create_directories(folder / name);
+    if (frame == 0) writeMeshPly(folder / (name + ".ply"), mesh);
+    writeMeshPly(framePath(folder, name, frame, "ply"), mesh);
+  }
+  writeBodyStates(framePath(dir, "bodies", frame, "txt"), scene, bodies.states());
 }
 
 // The frame loop, for either solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
@@ -165,6 +204,13 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
   SimulationSummary summary;
   const bool colliding = !scene.colliders.empty();
   if (colliding) writeColliderMeshes(scene, *shapes, dir, resume);
+  std::unique_ptr<RigidBodies> bodies;
+  if (!scene.bodies.empty()) {
+    bodies = std::make_unique<RigidBodies>(scene, shapes);
+    std::error_code error;
+    if (!resume) fs::remove_all(dir / "bodies", error);
+    fs::create_directories(dir / "bodies");
+  }
   const std::vector<int> existing = resume ? listFrames(dir, "particles", "ply") : std::vector<int>{};
   if (!existing.empty()) {
     summary.firstFrame = std::min(existing.back(), scene.output.frames);
@@ -172,25 +218,33 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     const ParticleFrame frame = readParticlePly(path);
     if (frame.dimensions != Dim) throw InputError(path.string(), "dimensions", "differs from the scene's");
     solver.setParticles(frame);
+    if (bodies) bodies->setStates(readBodyStates(framePath(dir, "bodies", summary.firstFrame, "txt"), scene));
   } else {
     ParticleFrame initial = initialParticles(scene);
-    if (colliding) {
+    if (colliding || bodies) {
       summary.removedParticles = removeParticlesInside(solver.colliders(), initial);
       if (initial.size() == 0)
-        throw InputError(scene.source, "colliders", "every fluid particle lies inside a collider");
+        throw InputError(scene.source, colliding ? "colliders" : "bodies",
+                         "every fluid particle lies inside a collider or a body");
     }
     solver.setParticles(initial);
   }
   const bool fresh = existing.empty();
   CsvFile stats(dir / "stats.csv", statsCsvHeader(), !fresh, summary.firstFrame);
-  std::unique_ptr<CsvFile> colliderTable;
+  std::unique_ptr<CsvFile> colliderTable, bodyTable;
   if (colliding)
     colliderTable = std::make_unique<CsvFile>(dir / "colliders.csv", collidersCsvHeader(), !fresh, summary.firstFrame);
+  if (bodies)
+    bodyTable = std::make_unique<CsvFile>(dir / "bodies.csv", bodiesCsvHeader(), !fresh, summary.firstFrame);
   ParticleFrame frame;
   if (fresh) {
     solver.getParticles(frame);
     stats.add(statsRow(0, 0.0, solver.size(), 0, 0, solver.measure(), 0.0, PhaseTimes{}, 0.0, NAN,
                        measureDamBreak(scene, frame)));
+    if (bodies) {
+      bodyTable->add(bodyRows(scene, 0, bodies->states(), std::vector<Wrench>(bodies->size())));
+      writeBodyFrame(scene, *shapes, *bodies, dir, 0);
+    }
     writeParticlePly(framePath(dir, "particles", 0, "ply"), frame);
   }
 
@@ -203,6 +257,10 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     solver.phaseTimes() = PhaseTimes{};
     double time = (f - 1) * frameDuration;
     solver.beginFrame(time);
+    if (bodies) {
+      bodies->beginFrame(time);
+      placeBodies(*bodies, solver.colliders());
+    }
     int iterations = 0, steps = 0;
     float smallestStep = INFINITY;
     double remaining = frameDuration;
@@ -217,8 +275,12 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
         dt = static_cast<float>(remaining / count);
         remaining = count == 1 ? 0 : remaining - dt;
       }
-      const long bad = solver.step(dt, time);
+      long badBody = -1;
+      const long bad = coupledStep<Dim>(solver, bodies.get(), dt, time, badBody);
       time += dt;
+      if (badBody >= 0)
+        throw RunError("simulation diverged at frame " + std::to_string(f) + ", substep " + std::to_string(steps) +
+                       ": body " + scene.bodies[badBody].solid.name + " (its state is not finite)");
       smallestStep = std::min(smallestStep, dt);
       iterations += solver.lastIterations();
       if (bad >= 0) {
@@ -236,9 +298,18 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     // are the ones kept, so stats.csv never misses a frame that is on disk.
     stats.add(statsRow(f, f * frameDuration, solver.size(), steps, double(iterations) / steps, measures, seconds,
                        solver.phaseTimes(), smallestStep, solver.maxPressure(), measureDamBreak(scene, frame)));
-    if (colliding) {
-      colliderTable->add(colliderRows(scene, f, solver.takeColliderWrenches(frameDuration)));
-      writeMovingColliderMeshes(scene, *shapes, dir, f);
+    if (colliding || bodies) {
+      std::vector<Wrench> wrenches = solver.takeColliderWrenches(frameDuration);
+      const auto firstBody = wrenches.begin() + std::ptrdiff_t(scene.colliders.size());
+      if (bodies) {
+        bodyTable->add(bodyRows(scene, f, bodies->states(), std::vector<Wrench>(firstBody, wrenches.end())));
+        writeBodyFrame(scene, *shapes, *bodies, dir, f);
+      }
+      wrenches.erase(firstBody, wrenches.end());
+      if (colliding) {
+        colliderTable->add(colliderRows(scene, f, wrenches));
+        writeMovingColliderMeshes(scene, *shapes, dir, f);
+      }
     }
     writeParticlePly(framePath(dir, "particles", f, "ply"), frame);
     progress.advance();
@@ -326,5 +397,8 @@ SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderSha
 }
 
 const char* collidersCsvHeader() { return "frame,collider,fx,fy,fz,tx,ty,tz"; }
+const char* bodiesCsvHeader() {
+  return "frame,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,fx,fy,fz,tx,ty,tz";
+}
 
 }  // namespace surge

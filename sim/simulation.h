@@ -27,6 +27,8 @@ struct SimulationSummary {
 // Also writes colliders.csv and the colliders' meshes (colliders/<name>.ply, and colliders/<name>/frame_NNNNN.ply
 // for a moving one) when the scene has colliders. `shapes` are the scene's built collider shapes (built here if
 // not given; building them first lets a caller refuse bad collider files before writing anything).
+// With bodies (sim/rigid_bodies.h): bodies.csv (frames 0..N), bodies/<name>.ply and bodies/<name>/frame_NNNNN.ply
+// (each body's mesh in the world), and bodies/frame_NNNNN.txt, the state a resumed run continues from.
 SimulationSummary simulate(const Scene& scene, const fs::path& dir, bool resume, Progress& progress);
 SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
                            bool resume, Progress& progress);
@@ -51,8 +53,9 @@ DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame)
 // whose front_x and back_height can be compared with experiments (Martin & Moyce 1952) and across runs.
 bool isDamBreak(const Scene& scene);
 
-// The columns of stats.csv and colliders.csv, in order.
+// The columns of stats.csv, colliders.csv and bodies.csv, in order.
 const char* statsCsvHeader();
 const char* collidersCsvHeader();
+const char* bodiesCsvHeader();
 
 }  // namespace surge

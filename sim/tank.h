@@ -41,19 +41,31 @@ void latticeSums(float spacing, float support, Weight weight, Gradient gradient,
 // magnitude of the gradient sum, which points from the particle towards the wall. Zero beyond the support; a
 // negative d reads as 0. The tank tabulates it; colliders (sim/colliders.h) use it for every shape, taking the
 // wall locally flat.
+//
+// Two moments of the gradient serve WCSPH's hydrostatic boundary pressure (sim/colliders.h): with r = p_i - p_b,
+// n the wall's normal and e a unit vector along the wall, normalMoment = sum_b (r . n) (grad W . n) and
+// tangentMoment = sum_b (r . e) (grad W . e), the same for every e along the wall's lattice axes; both <= 0.
 struct FlatWallTable {
-  std::vector<float> weight, gradient;
+  std::vector<float> weight, gradient, normalMoment, tangentMoment;
   float scale = 0;  // table entries per metre
 
   void lookup(float d, float& w, float& g) const {
+    w = at(weight, d);
+    g = at(gradient, d);
+  }
+  void moments(float d, float& normal, float& tangent) const {
+    normal = at(normalMoment, d);
+    tangent = at(tangentMoment, d);
+  }
+
+ private:
+  float at(const std::vector<float>& table, float d) const {
     const float u = std::max(d, 0.0f) * scale;
-    const int size = static_cast<int>(weight.size()) - 1;
-    w = g = 0;
-    if (!(u < size)) return;  // also NaN
+    const int size = static_cast<int>(table.size()) - 1;
+    if (!(u < size)) return 0;  // also NaN
     const int t = static_cast<int>(u);
     const float f = u - t;
-    w = (1 - f) * weight[t] + f * weight[t + 1];
-    g = (1 - f) * gradient[t] + f * gradient[t + 1];
+    return (1 - f) * table[t] + f * table[t + 1];
   }
 };
 
@@ -73,17 +85,19 @@ class TankWalls {
     // A particle at distance d from a wall sees lattice layers at d + spacing / 2 + k spacing beyond it,
     // tangentially aligned with the particle. The walls' normals are taken along axes 0, 1, 2 here.
     const int reach = static_cast<int>(std::ceil(support / spacing)) + 1;
-    const auto beyond = [&](int walls, const float* d, double* g) {
-      return sumBeyond(walls, d, spacing, reach, weight, gradient, g);
+    const auto beyond = [&](int walls, const float* d, double* g, double* moments = nullptr) {
+      return sumBeyond(walls, d, spacing, reach, weight, gradient, g, moments);
     };
-    flat_.weight.assign(kTableSize + 1, 0.0f);
-    flat_.gradient.assign(kTableSize + 1, 0.0f);
+    for (auto* table : {&flat_.weight, &flat_.gradient, &flat_.normalMoment, &flat_.tangentMoment})
+      table->assign(kTableSize + 1, 0.0f);
     flat_.scale = kTableSize / support;
     for (int t = 0; t <= kTableSize; ++t) {
       const float d[1] = {support * t / kTableSize};
-      double g[3];
-      flat_.weight[t] = static_cast<float>(beyond(1, d, g));
+      double g[3], moments[2];
+      flat_.weight[t] = static_cast<float>(beyond(1, d, g, moments));
       flat_.gradient[t] = static_cast<float>(-g[0]);  // g[0] <= 0: towards the wall
+      flat_.normalMoment[t] = static_cast<float>(moments[0]);
+      flat_.tangentMoment[t] = static_cast<float>(moments[1]);
     }
     // Along an edge where two walls meet, both walls' lattices hold the quarter beyond both: tabulate that
     // quarter (distances dA, dB to the two walls) so add() can count it once.
@@ -208,17 +222,18 @@ class TankWalls {
  private:
   // Over the lattice beyond `walls` walls whose normals are axes 0 .. walls-1, at distances d[a] from the
   // particle (layers d[a] + spacing / 2 + i spacing, i >= 0, on those axes; every tangential offset within
-  // `reach` on the others): returns the sum of weight(r) and writes the sum of gradient(r) to g.
+  // `reach` on the others): returns the sum of weight(r) and writes the sum of gradient(r) to g, and, if asked,
+  // sum r_0 gradient_0(r) and sum r_1 gradient_1(r) to moments.
   template <typename Weight, typename Gradient>
   static double sumBeyond(int walls, const float* d, float spacing, int reach, const Weight& weight,
-                          const Gradient& gradient, double* g) {
+                          const Gradient& gradient, double* g, double* moments = nullptr) {
     const float particleRadius = 0.5f * spacing;
     int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     for (int a = 0; a < Dim; ++a) {
       lo[a] = a < walls ? 0 : -reach;
       hi[a] = reach;
     }
-    double w = 0;
+    double w = 0, normalMoment = 0, tangentMoment = 0;
     g[0] = g[1] = g[2] = 0;
     for (int i = lo[0]; i <= hi[0]; ++i)
       for (int j = lo[1]; j <= hi[1]; ++j)
@@ -230,7 +245,13 @@ class TankWalls {
           w += weight(r);
           const VecD gr = gradient(r);
           for (int a = 0; a < Dim; ++a) g[a] += gr[a];
+          normalMoment += r[0] * gr[0];
+          tangentMoment += r[1] * gr[1];
         }
+    if (moments) {
+      moments[0] = normalMoment;
+      moments[1] = tangentMoment;
+    }
     return w;
   }
 

@@ -43,7 +43,7 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const Collider
       grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
             static_cast<float>(0.5 * scene.solver.kernel_radius)),
       walls_(makeWalls<Dim>(scene)) {
-  if (!scene.colliders.empty()) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
+  if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
   const SolverSettings& s = scene.solver;
   support_ = static_cast<float>(s.kernel_radius);
   smoothingLength_ = 0.5f * support_;
@@ -267,13 +267,15 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
       VecD wallGradient = VecD::Zero();
       walls_.add(x_[i], unusedWeight, wallGradient);
       pressureForce -= 2.0f * pressureTermI * wallGradient;
-      // The colliders likewise; each one's share is a force on the particle, recorded for colliders.csv.
+      // The colliders likewise, their pressure continued hydrostatically (Colliders::hydrostaticSum); each
+      // one's share is a force on the particle, recorded for colliders.csv.
       if (!colliders_.empty())
         colliders_.forEachNear(x_[i], [&](size_t c, float d, const VecD& n) {
           float unused;
           VecD gradient;
           colliders_.wallTerms(x_[i], d, n, unused, gradient);
-          const VecD force = -2.0f * pressureTermI * gradient;
+          const VecD force = -2.0f * pressureTermI * gradient -
+                             (1.0f / density_[i]) * colliders_.hydrostaticSum(d, n, gravity_);
           pressureForce += force;
           colliders_.addImpulse(i, c, (mass_ * mass_) * force, x_[i]);
         });

@@ -65,6 +65,7 @@ class WcsphSolver {
   // Each collider's mean force and torque from the fluid since the last call, over `duration` seconds.
   std::vector<Wrench> takeColliderWrenches(double duration) { return colliders_.takeFrameWrenches(duration); }
   const Colliders<Dim>& colliders() const { return colliders_; }
+  Colliders<Dim>& colliders() { return colliders_; }  // the bodies' coupling sets their poses here
   // Pressures of the last evaluation, in the particles' current order (for tests).
   const std::vector<float>& pressures() const { return pressure_; }
 

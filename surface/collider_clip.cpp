@@ -174,7 +174,7 @@ TriangleMesh checkedMesh(const ColliderSettings& settings, TriangleMesh mesh) {
 TriangleMesh readCollider(const ColliderSettings& settings, const fs::path& path) {
   std::error_code error;
   if (!fs::exists(path, error))
-    throw InputError(path.string(), "missing: the simulation writes colliders/; run surge sim again");
+    throw InputError(path.string(), "missing: the simulation writes colliders/ and bodies/; run surge sim again");
   return checkedMesh(settings, readMeshPly(path));
 }
 
@@ -280,37 +280,39 @@ SurfaceCollider makeSurfaceCollider(const ColliderSettings& settings, const Tria
   return c;
 }
 
-SurfaceColliders::SurfaceColliders(const fs::path& dir, const std::vector<ColliderSettings>& colliders,
-                                   double spacing, const ColliderGrids& grids)
-    : folder_(dir / "colliders"), settings_(colliders), grids_(grids) {
-  for (const ColliderSettings& s : settings_) {
-    thickness_.push_back(s.thickness > 0 ? s.thickness : spacing);
+SurfaceColliders::SurfaceColliders(const fs::path& dir, const std::vector<SolidFiles>& solids, double spacing,
+                                   const ColliderGrids& grids)
+    : dir_(dir), solids_(solids), grids_(grids) {
+  for (const SolidFiles& s : solids_) {
+    thickness_.push_back(s.settings.thickness > 0 ? s.settings.thickness : spacing);
     SurfaceCollider c;
-    c.name = s.name;
-    if (s.motion.size() <= 1)
-      c = makeSurfaceCollider(s, readCollider(s, folder_ / (s.name + ".ply")), grids_, thickness_.back());
+    c.name = s.settings.name;
+    if (!s.moving)
+      c = makeSurfaceCollider(s.settings, readCollider(s.settings, dir_ / s.folder / (c.name + ".ply")), grids_,
+                              thickness_.back());
     standing_.push_back(std::move(c));
   }
 }
 
 std::vector<SurfaceCollider> SurfaceColliders::atFrame(int frame) const {
   std::vector<SurfaceCollider> colliders = standing_;
-  for (size_t c = 0; c < settings_.size(); ++c) {
-    if (settings_[c].motion.size() <= 1) continue;
+  for (size_t c = 0; c < solids_.size(); ++c) {
+    const SolidFiles& s = solids_[c];
+    if (!s.moving) continue;
     std::error_code error;
-    fs::path path = framePath(folder_, settings_[c].name, frame, "ply");
-    if (!fs::exists(path, error)) path = folder_ / (settings_[c].name + ".ply");
-    colliders[c] = makeSurfaceCollider(settings_[c], readCollider(settings_[c], path), grids_, thickness_[c]);
+    fs::path path = framePath(dir_ / s.folder, s.settings.name, frame, "ply");
+    if (!fs::exists(path, error)) path = dir_ / s.folder / (s.settings.name + ".ply");
+    colliders[c] = makeSurfaceCollider(s.settings, readCollider(s.settings, path), grids_, thickness_[c]);
   }
   return colliders;
 }
 
 std::vector<fs::path> colliderFrameFiles(const fs::path& dir, const Scene& scene, int frame) {
   std::vector<fs::path> files;
-  for (const ColliderSettings& s : scene.colliders) {
+  for (const SolidFiles& s : solidFiles(scene)) {
     std::error_code error;
-    const fs::path path = framePath(dir / "colliders", s.name, frame, "ply");
-    if (s.motion.size() > 1 && fs::exists(path, error)) files.push_back(path);
+    const fs::path path = framePath(dir / s.folder, s.settings.name, frame, "ply");
+    if (s.moving && fs::exists(path, error)) files.push_back(path);
   }
   return files;
 }

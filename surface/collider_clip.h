@@ -76,23 +76,24 @@ struct ColliderGrids {
   bool flat = false;  // a 2D scene
 };
 
-// The colliders of an output folder. The standing ones are read and converted once, by the constructor; a
-// moving one at every frame (its frame file, or <name>.ply when that frame's file is missing).
+// The colliders and bodies of an output folder (core/scene.h's solidFiles). The standing ones are read and
+// converted once, by the constructor; a moving one (keyframed, or a body) at every frame (its frame file, or
+// <name>.ply when that frame's file is missing).
 class SurfaceColliders {
  public:
-  // Reads and converts the standing colliders among `colliders` (nothing when it is empty). `spacing` is the
-  // shell thickness of an open mesh whose `thickness` is 0. Throws InputError naming the file if a collider's
-  // mesh is missing or unreadable, or names a vertex it does not have.
-  SurfaceColliders(const fs::path& dir, const std::vector<ColliderSettings>& colliders, double spacing,
+  // Reads and converts the standing solids among `solids` (nothing when it is empty). `spacing` is the shell
+  // thickness of an open mesh whose `thickness` is 0. Throws InputError naming the file if a solid's mesh is
+  // missing or unreadable, or names a vertex it does not have.
+  SurfaceColliders(const fs::path& dir, const std::vector<SolidFiles>& solids, double spacing,
                    const ColliderGrids& grids);
 
-  bool empty() const { return settings_.empty(); }
-  // Every collider as it stands at `frame`, in the scene's order.
+  bool empty() const { return solids_.empty(); }
+  // Every solid as it stands at `frame`, in the scene's order.
   std::vector<SurfaceCollider> atFrame(int frame) const;
 
  private:
-  fs::path folder_;
-  std::vector<ColliderSettings> settings_;
+  fs::path dir_;
+  std::vector<SolidFiles> solids_;
   std::vector<double> thickness_;          // an open mesh's shell thickness
   std::vector<SurfaceCollider> standing_;  // one per collider; a moving one's is rebuilt at every frame
   ColliderGrids grids_;

@@ -539,10 +539,10 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
     };
     frames.erase(std::remove_if(frames.begin(), frames.end(), done), frames.end());
   }
-  // The colliders, the standing ones made level sets once here: none for a scene without colliders, nor
+  // The colliders and bodies, the standing ones made level sets once here: none for a scene without them, nor
   // when no frame is left to do.
-  const bool meet = !frames.empty() && !scene.colliders.empty();
-  const SurfaceColliders colliders(dir, meet ? scene.colliders : std::vector<ColliderSettings>(),
+  const bool meet = !frames.empty() && (!scene.colliders.empty() || !scene.bodies.empty());
+  const SurfaceColliders colliders(dir, meet ? solidFiles(scene) : std::vector<SolidFiles>(),
                                    scene.particle_spacing, meet ? colliderGrids(scene) : ColliderGrids());
   progress.start("surface", frames.size());
   // Frames in parallel, one chunk each (OpenVDB's and our own loops inside a frame share the same oneTBB

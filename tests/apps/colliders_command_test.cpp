@@ -28,28 +28,11 @@ const char* kObstacles = R"({
   "output": {"fps": 30, "frames": 6}
 })";
 
-fs::path freshFolder(const std::string& name) {
-  const fs::path dir = fs::path(testing::TempDir()) / name;
-  fs::remove_all(dir);
-  return dir;
-}
-
-std::vector<std::string> lines(const std::string& text) {
-  std::vector<std::string> out;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) out.push_back(line);
-  return out;
-}
-
 TEST(CollidersCommand, SameBytesAtOneAndTwoThreadsAndAfterResume) {
-  const fs::path scene = writeTestScene("obstacles.json", kObstacles);
-  const fs::path one = freshFolder("colliders_1"), two = freshFolder("colliders_2"), resumed = freshFolder("colliders_r");
-  const std::string base = "sim '" + scene.string() + "' --quiet";
-  const SurgeResult first = runSurge("sim '" + scene.string() + "' --threads 1 --out " + one.string());
-  ASSERT_EQ(first.status, 0) << first.err;
-  ASSERT_EQ(runSurge(base + " --threads 2 --out " + two.string()).status, 0);
-  ASSERT_EQ(runSurge(base + " --threads 2 --set output.frames=3 --out " + resumed.string()).status, 0);
-  ASSERT_EQ(runSurge(base + " --threads 2 --resume --out " + resumed.string()).status, 0);
+  const ThreeRuns runs = simulateThreeWays(writeTestScene("obstacles.json", kObstacles), "colliders", 3);
+  ASSERT_TRUE(runs.ok) << runs.first.err;
+  const fs::path &one = runs.one, &two = runs.two, &resumed = runs.resumed;
+  const SurgeResult& first = runs.first;
   for (int f = 0; f <= 6; ++f) {
     const std::string frame = readTextFile(framePath(one, "particles", f, "ply"));
     EXPECT_EQ(frame, readTextFile(framePath(two, "particles", f, "ply"))) << "frame " << f;

@@ -7,7 +7,9 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/files.h"
 
@@ -38,6 +40,42 @@ inline fs::path writeTestScene(const std::string& name, const std::string& text)
   const fs::path path = fs::path(testing::TempDir()) / (std::to_string(::getpid()) + "_" + name);
   std::ofstream(path) << text;
   return path;
+}
+
+// An empty place for a run's output folder under the test's temporary folder.
+inline fs::path freshFolder(const std::string& name) {
+  const fs::path dir = fs::path(testing::TempDir()) / name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+// The lines of a text (a CSV file's rows).
+inline std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+// `surge sim` on one scene three ways: at 1 thread, at 2, and at 2 stopped after `stopAfter` frames and then
+// resumed; the folders are `prefix`_1, _2 and _r. first is the 1-thread run's result.
+struct ThreeRuns {
+  fs::path one, two, resumed;
+  SurgeResult first;
+  bool ok = false;
+};
+inline ThreeRuns simulateThreeWays(const fs::path& scene, const std::string& prefix, int stopAfter) {
+  ThreeRuns runs;
+  runs.one = freshFolder(prefix + "_1");
+  runs.two = freshFolder(prefix + "_2");
+  runs.resumed = freshFolder(prefix + "_r");
+  const std::string base = "sim '" + scene.string() + "' --quiet --threads 2";
+  runs.first = runSurge("sim '" + scene.string() + "' --threads 1 --out " + runs.one.string());
+  runs.ok = runs.first.status == 0 && runSurge(base + " --out " + runs.two.string()).status == 0 &&
+            runSurge(base + " --set output.frames=" + std::to_string(stopAfter) + " --out " +
+                     runs.resumed.string()).status == 0 &&
+            runSurge(base + " --resume --out " + runs.resumed.string()).status == 0;
+  return runs;
 }
 
 }  // namespace surge

@@ -26,12 +26,6 @@ const char* kSmallDamBreak = R"({
   "output": {"fps": 30, "frames": 24}
 })";
 
-fs::path freshFolder(const std::string& name) {
-  const fs::path dir = fs::path(testing::TempDir()) / name;
-  fs::remove_all(dir);
-  return dir;
-}
-
 TEST(SimCommand, SameBytesWithOneAndTwoThreads) {
   const fs::path scene = writeTestScene("small.json", kSmallDamBreak);
   const fs::path one = freshFolder("surge_threads_1"), two = freshFolder("surge_threads_2");

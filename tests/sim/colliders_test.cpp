@@ -290,13 +290,14 @@ TEST(Colliders, SubmergedSphereFeelsArchimedesPbf) {
 }
 
 TEST(Colliders, SubmergedSphereFeelsArchimedesWcsph) {
-  // In 2D a ball is a disc: V is its area, the force per unit depth. WCSPH reads 7.4% over rho g V here (and
-  // 27% over in 3D, docs/colliders.md: an open problem of the flat-wall model with WCSPH's mirrored pressure at
-  // a ball 4 spacings across); this holds it to what it does, within 10%, so a change for the worse shows.
+  // In 2D a ball is a disc: V is its area, the force per unit depth. With the wall's pressure continued
+  // hydrostatically (Colliders::hydrostaticSum) WCSPH reads within 1% of rho g V here; mirroring the particle's
+  // pressure alone read 7.7% over (docs/colliders.md). Held to the 5% PBF is held to, after 2.5 s of settling:
+  // WCSPH's pool sloshes longer than PBF's, and after 1.5 s its sideways force still swung by 2-3% of rho g V.
   const Scene scene = makeScene(2, R"({"min": [0, 0], "max": [0.6, 0.6]})", R"([{"box": {"min": [0, 0], "max": [0.6, 0.4]}}])",
                                 R"([{"shape": "sphere", "position": [0.3, 0.2], "radius": 0.08}])", 0.02,
                                 {"solver.method=wcsph"});
-  checkBuoyancy<2, WcsphSolver<2>>(scene, M_PI * 0.08 * 0.08, 1.5, 1.0, 0.10);
+  checkBuoyancy<2, WcsphSolver<2>>(scene, M_PI * 0.08 * 0.08, 2.5, 1.0);
 }
 
 // The force bookkeeping is exact where the model is: a plane laid as the tank's floor carries all the water's

@@ -1,0 +1,226 @@
+// Rigid bodies against Archimedes and Newton: the draft of floating boxes in 3D and 2D, a heavy ball that sinks
+// and stays down, a light box that rises from the deep, a cube that tips and one that does not (the torque, not
+// only the force), and momentum exchanged with the fluid. Each runs the frame loop (simulate) into a folder and
+// reads bodies.csv and the particle frames, as a user would.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/ply.h"
+#include "core/scene.h"
+#include "sim/pbf_solver.h"
+#include "sim/simulation.h"
+
+namespace surge {
+namespace {
+
+struct BodyRow {
+  int frame = 0;
+  Eigen::Vector3d position, velocity, angularVelocity, force, torque;
+  Eigen::Quaterniond orientation;
+};
+
+// bodies.csv's rows of body `name`, by frame.
+std::vector<BodyRow> readBodies(const fs::path& dir, const std::string& name) {
+  std::ifstream in(dir / "bodies.csv");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, bodiesCsvHeader());
+  std::vector<BodyRow> rows;
+  while (std::getline(in, line)) {
+    std::istringstream fields(line);
+    std::string cell;
+    std::vector<std::string> cells;
+    while (std::getline(fields, cell, ',')) cells.push_back(cell);
+    if (cells.size() != 21 || cells[1] != name) continue;
+    std::vector<double> v;
+    for (size_t k = 2; k < cells.size(); ++k) v.push_back(std::stod(cells[k]));
+    BodyRow r;
+    r.frame = std::stoi(cells[0]);
+    r.position = {v[0], v[1], v[2]};
+    r.orientation = Eigen::Quaterniond(v[3], v[4], v[5], v[6]);
+    r.velocity = {v[7], v[8], v[9]};
+    r.angularVelocity = {v[10], v[11], v[12]};
+    r.force = {v[13], v[14], v[15]};
+    r.torque = {v[16], v[17], v[18]};
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+fs::path runScene(const Scene& scene) {
+  const fs::path dir = fs::path(testing::TempDir()) / ("bodies_" + scene.name);
+  fs::remove_all(dir);
+  Progress quiet;
+  simulate(scene, dir, false, quiet);
+  return dir;
+}
+
+// The free surface far from the bodies: the mean height of the particles in the top layer (within a spacing
+// of the highest) farther than `clear` from (x, z) = centre, plus half a spacing.
+double surfaceHeight(const Scene& scene, const ParticleFrame& frame, const Eigen::Vector3d& centre, double clear) {
+  const double spacing = scene.particle_spacing;
+  std::vector<double> heights;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    Eigen::Vector3d p = frame.position[i].cast<double>();
+    Eigen::Vector3d d = p - centre;
+    d.y() = 0;
+    if (d.norm() > clear) heights.push_back(p.y());
+  }
+  std::sort(heights.begin(), heights.end());
+  double sum = 0;
+  size_t count = 0;
+  for (double y : heights)
+    if (y > heights.back() - spacing) sum += y, ++count;
+  return sum / count + 0.5 * spacing;
+}
+
+// The angle (degrees) between the body's local y axis and the world's.
+double tiltDegrees(const Eigen::Quaterniond& q) {
+  const double c = std::clamp((q * Eigen::Vector3d::UnitY()).dot(Eigen::Vector3d::UnitY()), -1.0, 1.0);
+  return std::acos(c) * 180 / M_PI;
+}
+
+Scene pool(int dimensions, const std::string& bodies, double spacing = 0.02, const std::string& extra = "") {
+  const std::string domain = dimensions == 3 ? R"({"min": [0, 0, 0], "max": [0.6, 0.5, 0.6]})"
+                                             : R"({"min": [0, 0], "max": [0.8, 0.5]})";
+  const std::string water = dimensions == 3 ? R"([{"box": {"min": [0, 0, 0], "max": [0.6, 0.3, 0.6]}}])"
+                                            : R"([{"box": {"min": [0, 0], "max": [0.8, 0.3]}}])";
+  return parseScene(R"({"name": "pool)" + std::to_string(dimensions) + R"(", "dimensions": )" +
+                        std::to_string(dimensions) + R"(, "domain": )" + domain + R"(, "particle_spacing": )" +
+                        std::to_string(spacing) + R"(, "fluids": )" + water + R"(, "bodies": )" + bodies + extra +
+                        "}",
+                    "test");
+}
+
+// A flat box of relative density s floats with s of its height under water (Archimedes), measured against the
+// free surface away from it, averaged over the last half second; within 5% of its height as the issue asks.
+// PBF's pool is compressed by its few iterations (about 3% at 4 x 4): the water's true mean density rho sets
+// the draft, s rho_0 / rho of the height, which the measured surface already reflects through the volume.
+void checkDraft(int dimensions, double relative) {
+  const double height = 0.1;
+  const std::string size = dimensions == 3 ? "[0.2, 0.1, 0.2]" : "[0.2, 0.1]";
+  const std::string position = dimensions == 3 ? "[0.3, 0.33, 0.3]" : "[0.4, 0.33]";
+  Scene scene = pool(dimensions,
+                     R"([{"name": "raft", "shape": "box", "position": )" + position + R"(, "size": )" + size +
+                         R"(, "density": )" + std::to_string(1000 * relative) + "}]",
+                     0.02, R"(, "output": {"frames": 75})");
+  scene.name += "_draft" + std::to_string(int(relative * 100));
+  const fs::path dir = runScene(scene);
+  const std::vector<BodyRow> rows = readBodies(dir, "raft");
+  ASSERT_EQ(rows.size(), 76u);
+  double draft = 0;
+  int count = 0;
+  for (int f = 60; f <= 75; ++f) {
+    const ParticleFrame frame = readParticlePly(framePath(dir, "particles", f, "ply"));
+    const double surface = surfaceHeight(scene, frame, rows[f].position, 0.2);
+    draft += surface - (rows[f].position.y() - 0.5 * height);
+    ++count;
+  }
+  draft /= count;
+  std::printf("%dD, s = %.2f: draft %.4f m, expected %.4f m (%.1f%% of the height off)\n", dimensions, relative,
+              draft, relative * height, 100 * (draft - relative * height) / height);
+  EXPECT_NEAR(draft, relative * height, 0.05 * height);
+  EXPECT_LT(tiltDegrees(rows.back().orientation), 5.0);
+}
+
+TEST(Bodies, FlatBoxFloatsAtItsDraft3d) {
+  checkDraft(3, 0.5);
+  checkDraft(3, 0.3);
+}
+
+TEST(Bodies, FlatBoxFloatsAtItsDraft2d) {
+  checkDraft(2, 0.5);
+  checkDraft(2, 0.3);
+  checkDraft(2, 0.8);
+}
+
+// A ball of density 2000 sinks and stays on the floor: its centre a radius above it (Bullet's contact within a
+// tenth of a spacing), at rest.
+TEST(Bodies, HeavySphereSinksAndStaysDown) {
+  Scene scene = pool(3, R"([{"name": "ball", "shape": "sphere", "position": [0.3, 0.25, 0.3], "radius": 0.05,
+                             "density": 2000}])",
+                     0.02, R"(, "output": {"frames": 45})");
+  const std::vector<BodyRow> rows = readBodies(runScene(scene), "ball");
+  for (size_t f = 30; f < rows.size(); ++f) {
+    EXPECT_NEAR(rows[f].position.y(), 0.05, 0.004) << "frame " << f;
+    EXPECT_LT(rows[f].velocity.norm(), 0.02) << "frame " << f;
+  }
+}
+
+// A box of relative density 0.5 released deep (its bottom 3 spacings above the floor, so water lies under it:
+// a box flat on the floor with none under it feels no pressure from below, as in a real tank) rises and
+// surfaces: its top comes above the water.
+TEST(Bodies, LightBoxRisesFromTheDeep2d) {
+  Scene scene = pool(2, R"([{"name": "box", "shape": "box", "position": [0.4, 0.11], "size": [0.1, 0.1],
+                             "density": 500}])",
+                     0.02, R"(, "output": {"frames": 45})");
+  const fs::path dir = runScene(scene);
+  const std::vector<BodyRow> rows = readBodies(dir, "box");
+  const ParticleFrame last = readParticlePly(framePath(dir, "particles", 45, "ply"));
+  const double surface = surfaceHeight(scene, last, rows.back().position, 0.15);
+  EXPECT_GT(rows.back().position.y() + 0.05, surface);
+  EXPECT_GT(rows[10].velocity.y(), 0.1);  // rising
+}
+
+// A cube face down (tilted 4 degrees to break the symmetry): at relative density 0.5 its metacentric height
+// a / (12 s) - a (1 - s) / 2 is below zero and it tips over (towards 45 degrees); at 0.15 it is above zero and
+// the cube rights itself. The torque, not only the force, decides which.
+void checkTipping(int dimensions, double relative, bool tips) {
+  const std::string size = dimensions == 3 ? "[0.16, 0.16, 0.16]" : "[0.16, 0.16]";
+  const std::string position = dimensions == 3 ? "[0.3, 0.33, 0.3]" : "[0.4, 0.33]";
+  const std::string axis = dimensions == 3 ? "[1, 0, 0]" : "[0, 0, 1]";
+  Scene scene = pool(dimensions,
+                     R"([{"name": "cube", "shape": "box", "position": )" + position + R"(, "size": )" + size +
+                         R"(, "rotation": {"axis": )" + axis + R"(, "degrees": 4}, "density": )" +
+                         std::to_string(1000 * relative) + "}]",
+                     0.02, R"(, "output": {"frames": 120})");
+  scene.name += "_tip" + std::to_string(int(relative * 100));
+  const std::vector<BodyRow> rows = readBodies(runScene(scene), "cube");
+  double last = 0;
+  for (size_t f = 90; f < rows.size(); ++f) last += tiltDegrees(rows[f].orientation) / double(rows.size() - 90);
+  std::printf("%dD cube, s = %.2f: tilt %.1f degrees over the last second\n", dimensions, relative, last);
+  if (tips)
+    EXPECT_GT(last, 25.0);
+  else
+    EXPECT_LT(last, 4.0);
+}
+
+TEST(Bodies, CubeAtHalfDensityTipsOver2d) { checkTipping(2, 0.5, true); }
+TEST(Bodies, CubeAtFifteenPercentStaysFaceDown2d) { checkTipping(2, 0.15, false); }
+TEST(Bodies, CubeAtHalfDensityTipsOver3d) { checkTipping(3, 0.5, true); }
+TEST(Bodies, CubeAtFifteenPercentStaysFaceDown3d) { checkTipping(3, 0.15, false); }
+
+// Without gravity and away from the walls, a ball shot into a blob of water: what the ball loses the water
+// gains. The total momentum of both stays within 2% of the ball's initial momentum over half a second (the
+// coupling lags a step: the ball feels the water's push one step late).
+TEST(Bodies, MomentumIsExchangedWithTheFluid) {
+  const Scene scene = parseScene(R"({"name": "shot", "dimensions": 3,
+    "domain": {"min": [0, 0, 0], "max": [1, 1, 1]}, "particle_spacing": 0.02, "gravity": [0, 0, 0],
+    "fluids": [{"box": {"min": [0.4, 0.3, 0.3], "max": [0.7, 0.7, 0.7]}}],
+    "bodies": [{"name": "ball", "shape": "sphere", "position": [0.3, 0.5, 0.5], "radius": 0.05, "density": 1500,
+                "velocity": [1, 0, 0]}],
+    "output": {"frames": 15}})",
+                                 "test");
+  const fs::path dir = runScene(scene);
+  const std::vector<BodyRow> rows = readBodies(dir, "ball");
+  PbfSolver<3> solver(scene);
+  const double particleMass = solver.particleMass();
+  const double ballMass = 1500 * 4.0 / 3.0 * M_PI * std::pow(0.05, 3);
+  const Eigen::Vector3d initial = ballMass * rows[0].velocity;
+  for (int f = 0; f <= 15; f += 5) {
+    const ParticleFrame frame = readParticlePly(framePath(dir, "particles", f, "ply"));
+    Eigen::Vector3d fluid = Eigen::Vector3d::Zero();
+    for (size_t i = 0; i < frame.size(); ++i) fluid += particleMass * frame.velocity[i].cast<double>();
+    const Eigen::Vector3d total = fluid + ballMass * rows[f].velocity;
+    std::printf("frame %2d: ball %.4f, fluid %.4f, total %.4f kg m/s (x)\n", f, ballMass * rows[f].velocity.x(),
+                fluid.x(), total.x());
+    EXPECT_NEAR((total - initial).norm(), 0.0, 0.02 * initial.norm()) << "frame " << f;
+  }
+  EXPECT_LT(rows[15].velocity.x(), 0.8);  // the water slowed the ball
+}
+
+}  // namespace
+}  // namespace surge
