@@ -42,6 +42,11 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   for (const ColliderShape& shape : *shapes)
     if (!shape.note.empty()) say(options, "sim: " + shape.note);
   if (!scene.bodies.empty()) RigidBodies check(scene, shapes);
+  if (scene.solver.method == "pbf" && stableSubsteps(scene) > scene.solver.substeps)
+    say(options, "sim: note: solver.substeps " + std::to_string(scene.solver.substeps) + " is below the " +
+                     std::to_string(stableSubsteps(scene)) +
+                     " a PBF pool this deep needs to stay at rest (dt <= 0.9 particle_spacing / sqrt(g depth)); "
+                     "leave it out to get them");
   const std::string json = sceneToJson(scene);
   std::error_code error;
   const bool existing = fs::exists(dir / "scene.json", error);

@@ -446,6 +446,7 @@ void validate(Scene& s, const std::string& where) {
                          " GB, more than this machine's " + formatNumber(std::floor(memory / 1e9)) + " GB");
 
   SolverSettings& solver = s.solver;
+  if (solver.substeps == 0) solver.substeps = std::max(4, stableSubsteps(s));
   if (solver.kernel_radius == 0) solver.kernel_radius = 2 * spacing;
   if (solver.kernel_radius <= spacing)
     throw InputError(where, "solver.kernel_radius", "must exceed particle_spacing, or particles have no neighbours");
@@ -555,6 +556,26 @@ Scene parseScene(const std::string& text, const std::string& where, const std::v
   validate(scene, where);
   scene.source = where;
   return scene;
+}
+
+int stableSubsteps(const Scene& scene) {
+  const int d = scene.dimensions;
+  const Eigen::VectorXd gravity = scene.gravity.head(d);
+  const double g = gravity.norm();
+  if (!(g > 0)) return 1;
+  // The depth of the pool the fluid settles into: its volume over the tank's floor, the floor being the tank's
+  // section across the axis gravity is mostly along.
+  int down = 0;
+  gravity.cwiseAbs().maxCoeff(&down);
+  double floor = 1, volume = 0;
+  for (int k = 0; k < d; ++k)
+    if (k != down) floor *= scene.domain.max[k] - scene.domain.min[k];
+  for (const FluidBlock& fluid : scene.fluids) volume += (fluid.box.max - fluid.box.min).head(d).prod();
+  const double depth = std::min(volume / floor, scene.domain.max[down] - scene.domain.min[down]);
+  if (!(depth > 0)) return 1;
+  const double longest = 0.9 * scene.particle_spacing / std::sqrt(g * depth);
+  const double steps = std::ceil(1.0 / (scene.output.fps * longest) - 1e-9);
+  return int(std::min(steps, 100000.0));
 }
 
 std::vector<SolidFiles> solidFiles(const Scene& scene) {

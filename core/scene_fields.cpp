@@ -167,7 +167,9 @@ void visitScene(Scene& s, SceneVisitor& v) {
              info("pbf: Position Based Fluids (Macklin & Mueller 2013); wcsph: weakly compressible SPH "
                   "(Monaghan 1994, Becker & Teschner 2007)"));
     v.integer("substeps", s.solver.substeps,
-              atLeast(1, "PBF: time steps per output frame (WCSPH chooses its own, see time_step)", "", 100000));
+              atLeast(0, "PBF: time steps per output frame (WCSPH chooses its own, see time_step); 0: 4, or more "
+                         "if the pool the fluid settles into is deep enough to need them (dt <= 0.9 "
+                         "particle_spacing / sqrt(g depth))", "", 100000));
     v.integer("iterations", s.solver.iterations, atLeast(1, "PBF: Jacobi iterations per step", "", 10000));
     v.real("kernel_radius", s.solver.kernel_radius,
            atLeast(0, "SPH kernel radius h; 0 means 2 x particle_spacing", "m"));
