@@ -1,8 +1,10 @@
 #include "sim/colliders.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "core/errors.h"
 #include "geometry/pose.h"
 
 namespace surge {
@@ -30,8 +32,18 @@ Colliders<Dim>::Colliders(const Scene& scene, std::shared_ptr<const ColliderShap
   support_ = static_cast<float>(scene.solver.kernel_radius);
   radius_ = static_cast<float>(0.5 * scene.particle_spacing);
   placed_.resize(settings_.size());
+  if (placed_.size() > 65535) throw InputError(scene.source, "colliders", "more than 65535 colliders and bodies");
+  for (size_t c = 0; c < placed_.size(); ++c) all_.push_back(static_cast<uint16_t>(c));
   extra_.assign(settings_.size(), Wrench{});
   stepMark_ = extra_;
+  // The candidates' grid over the tank.
+  for (int k = 0; k < Dim; ++k) {
+    const float extent = static_cast<float>(scene.domain.max[k] - scene.domain.min[k]);
+    const float cell = std::max(2 * support_, extent / 64);
+    gridCounts_[k] = std::max(1, static_cast<int>(std::ceil(extent / cell)));
+    gridMin_[k] = static_cast<float>(scene.domain.min[k]);
+    cellInverse_[k] = gridCounts_[k] / extent;
+  }
   for (size_t c = 0; c < placed_.size(); ++c) {
     placed_[c].shape = &(*shapes_)[c];
     placed_[c].friction = static_cast<float>(settings_[c].friction);
@@ -97,6 +109,41 @@ void Colliders<Dim>::beginStep(double time, float dt) {
     k.near = Eigen::AlignedBox<float, Dim>(world.min().template head<Dim>() - Vec<Dim>::Constant(grow),
                                            world.max().template head<Dim>() + Vec<Dim>::Constant(grow));
   }
+  buildGrid();
+}
+
+template <int Dim>
+void Colliders<Dim>::buildGrid() {
+  // Each collider is listed in the cells its near box reaches, grown by a margin that covers a short move and
+  // the pushes it may take (project).
+  const float margin = (kShortMove + 2 * kShortMove + 2) * radius_;
+  size_t cells = 1;
+  for (int k = 0; k < Dim; ++k) cells *= size_t(gridCounts_[k]);
+  std::vector<uint32_t> count(cells + 1, 0);
+  auto forCells = [&](const Eigen::AlignedBox<float, Dim>& box, auto&& f) {
+    Eigen::Array<int, Dim, 1> lo, hi;
+    for (int k = 0; k < Dim; ++k) {
+      const float a = (box.min()[k] - margin - gridMin_[k]) * cellInverse_[k];
+      const float b = (box.max()[k] + margin - gridMin_[k]) * cellInverse_[k];
+      lo[k] = static_cast<int>(std::clamp(std::floor(a), 0.0f, float(gridCounts_[k] - 1)));
+      hi[k] = static_cast<int>(std::clamp(std::floor(b), 0.0f, float(gridCounts_[k] - 1)));
+      if (!(b >= 0) || !(a < gridCounts_[k])) return;  // off the grid (or NaN)
+    }
+    const int zLo = Dim == 3 ? lo[Dim - 1] : 0, zHi = Dim == 3 ? hi[Dim - 1] : 0;
+    for (int z = zLo; z <= zHi; ++z)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int x = lo[0]; x <= hi[0]; ++x) {
+          size_t index = Dim == 3 ? (size_t(z) * gridCounts_[1] + y) * gridCounts_[0] + x
+                                  : size_t(y) * gridCounts_[0] + x;
+          f(index);
+        }
+  };
+  for (size_t c = 0; c < placed_.size(); ++c) forCells(placed_[c].near, [&](size_t i) { ++count[i + 1]; });
+  for (size_t i = 0; i < cells; ++i) count[i + 1] += count[i];
+  cellStart_ = count;
+  cellSolids_.resize(count[cells]);
+  for (size_t c = 0; c < placed_.size(); ++c)
+    forCells(placed_[c].near, [&](size_t i) { cellSolids_[count[i]++] = static_cast<uint16_t>(c); });
 }
 
 template <int Dim>

@@ -71,14 +71,17 @@ class Colliders {
   size_t firstBody() const { return firstBody_; }
   void setBodyPose(size_t body, const Pose& pose, const Eigen::Vector3d& centreOfMass);
 
-  // Calls visit(c, distance, normal) for every collider whose surface is within the kernel support of p.
+  // Calls visit(c, distance, normal) for every collider whose surface is within the kernel support of p, in
+  // the colliders' order.
   template <typename Visit>
   void forEachNear(const VecD& p, Visit&& visit) const {
-    for (size_t c = 0; c < placed_.size(); ++c) {
-      if (!placed_[c].near.contains(p)) continue;
+    const uint16_t *c = nullptr, *end = nullptr;
+    candidates(p, c, end);
+    for (; c != end; ++c) {
+      if (!placed_[*c].near.contains(p)) continue;
       VecD normal;
-      const float d = distance(c, p, normal);
-      if (d < support_) visit(c, d, normal);
+      const float d = distance(*c, p, normal);
+      if (d < support_) visit(*c, d, normal);
     }
   }
 
@@ -125,11 +128,14 @@ class Colliders {
   template <typename Pushed>
   bool project(const VecD& from, VecD& p, bool fromStepStart, Pushed&& pushed) const {
     bool moved = false;
-    for (size_t c = 0; c < placed_.size(); ++c) {
+    // A move shorter than kShortMove, and the pushes it may take, stay within the grid's margin of p's cell.
+    const uint16_t *c = all_.data(), *end = all_.data() + all_.size();
+    if ((p - from).squaredNorm() < kShortMove * kShortMove * radius_ * radius_) candidates(p, c, end);
+    for (; c != end; ++c) {
       VecD delta;
-      if (sweep(c, from, p, fromStepStart, delta)) {
+      if (sweep(*c, from, p, fromStepStart, delta)) {
         p += delta;
-        pushed(c, delta);
+        pushed(*c, delta);
         moved = true;
       }
     }
@@ -186,6 +192,29 @@ class Colliders {
 
   bool sweep(size_t c, const VecD& from, const VecD& p, bool fromStepStart, VecD& delta) const;
 
+  // The colliders whose near boxes, grown by the grid's margin, reach the grid cell of p (every collider for a
+  // p off the grid), ascending: a particle tests those only, not all of them (ten floating bodies cost 17% of a
+  // step when every particle tested every one). Built by beginStep over the tank, cells at least twice the
+  // kernel support and at most 64 a side.
+  void candidates(const VecD& p, const uint16_t*& begin, const uint16_t*& end) const {
+    Eigen::Array<int, Dim, 1> cell;
+    for (int k = 0; k < Dim; ++k) {
+      const float u = (p[k] - gridMin_[k]) * cellInverse_[k];
+      if (!(u >= 0 && u < gridCounts_[k])) {  // also NaN
+        begin = all_.data();
+        end = all_.data() + all_.size();
+        return;
+      }
+      cell[k] = static_cast<int>(u);
+    }
+    size_t index = cell[Dim - 1];
+    for (int k = Dim - 2; k >= 0; --k) index = index * gridCounts_[k] + cell[k];
+    begin = cellSolids_.data() + cellStart_[index];
+    end = cellSolids_.data() + cellStart_[index + 1];
+  }
+  void buildGrid();
+  static constexpr float kShortMove = 4;  // in particle radii
+
   std::shared_ptr<const ColliderShapes> shapes_;
   std::vector<ColliderSettings> settings_;
   std::vector<Placed> placed_;
@@ -193,6 +222,10 @@ class Colliders {
   float support_ = 0, radius_ = 0, dt_ = 1;
   bool hasFriction_ = false;
   std::vector<Wrench> slots_, extra_, stepMark_;
+  std::vector<uint16_t> all_, cellSolids_;
+  std::vector<uint32_t> cellStart_;
+  VecD gridMin_ = VecD::Zero(), cellInverse_ = VecD::Zero();
+  Eigen::Array<int, Dim, 1> gridCounts_ = Eigen::Array<int, Dim, 1>::Zero();
   size_t firstBody_ = 0;
   std::vector<Pose> bodyStart_, bodyEnd_;
   std::vector<Eigen::Vector3d> bodyCentre_;
