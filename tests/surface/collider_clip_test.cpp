@@ -258,6 +258,28 @@ TEST(ColliderClip, WaterMeetsABoxWithoutGapOrOverlap) {
   }
 }
 
+// A rigid body is met as a moving collider whose meshes are in bodies/ (core/scene.h's solidFiles): the same
+// wall as a body, its mesh only in bodies/<name>/frame_00000.ply (bodies/<name>.ply stands elsewhere, so reading
+// the wrong one shows), is met with the same figures as the collider above.
+TEST(ColliderClip, WaterMeetsABodyAsItStandsAtTheFrame) {
+  Scene scene = sceneWithSpacing(kH);
+  BodySettings raft;
+  raft.solid = collider("raft", "box");
+  raft.density = 500;
+  scene.bodies = {raft};
+  const fs::path dir = uniqueTempDir();
+  const Box elsewhere{{2, 2, 2}, {2.1, 2.1, 2.1}};
+  writeMeshPly(dir / "bodies" / "raft.ply", boxColliderMesh(elsewhere));
+  writeMeshPly(framePath(dir / "bodies", "raft", 0, "ply"), boxColliderMesh(kWall));
+  const Surfaced run = surfaceFolder(dir, scene, waterBlock(kFluid, kH, 0.1), {});
+  const Contact with = measureContact(run, kWall, kFluid);
+  print("body", with);
+  EXPECT_LE(with.penetration, 0.1 * kVoxel);
+  EXPECT_GE(with.levelSetInside, -0.1 * kVoxel);
+  EXPECT_LE(with.gap, kVoxel);
+  EXPECT_LE(with.retreat, kVoxel);
+}
+
 TEST(ColliderClip, ContainerAndFloorPlaneHoldTheWater) {
   // The same water in a box container whose floor and three walls are the water's faces, and on a floor
   // plane: no vertex in the solid (outside the container, under the plane) deeper than a tenth of a voxel.
