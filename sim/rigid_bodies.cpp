@@ -4,7 +4,9 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -23,6 +25,8 @@ Eigen::Quaterniond fromBullet(const btQuaternion& q) { return Eigen::Quaterniond
 btTransform toBullet(const Pose& pose) {
   return btTransform(toBullet(pose.rotation), toBullet(pose.translation));
 }
+
+constexpr double kLongestBulletStep = 1e-3;  // s
 
 // Bullet's contact margin: a tenth of the particle spacing (Bullet's default of 4 cm is larger than many bodies).
 double contactMargin(const Scene& scene) { return 0.1 * scene.particle_spacing; }
@@ -163,6 +167,12 @@ RigidBodies::RigidBodies(const Scene& scene, std::shared_ptr<const ColliderShape
       s = w.keep(hull, margin);
     }
     w.bodyShapes.push_back(s);
+    // The largest sphere about the centre inside the body (the hull's nearest face for a mesh).
+    double inner = 0;
+    if (shape.kind == ShapeKind::Box) inner = scale * shape.halfExtents.head(scene.dimensions).minCoeff();
+    else if (shape.kind == ShapeKind::Mesh) inner = 0.5 * scale * shape.bounds.sizes().minCoeff();
+    else inner = scale * shape.radius;
+    innerRadius_.push_back(inner);
     mass_.push_back(m);
     principal_.push_back(axes);
 
@@ -275,6 +285,10 @@ void RigidBodies::beginFrame(double time) {
     body->setAngularVelocity(toBullet(s.angularVelocity));
     body->setActivationState(DISABLE_DEACTIVATION);  // a body at rest still feels the water
     body->setUserIndex(int(b));
+    // Continuous collision for a fast body: a step that would carry it further than half its smallest extent
+    // stops at the first contact instead of sinking deep into a wall and being pushed back out over later steps.
+    body->setCcdMotionThreshold(0.5 * innerRadius_[b]);
+    body->setCcdSweptSphereRadius(0.8 * innerRadius_[b]);
     if (scene_.dimensions == 2) {
       body->setLinearFactor(btVector3(1, 1, 0));
       body->setAngularFactor(btVector3(0, 0, 1));
@@ -291,11 +305,17 @@ long RigidBodies::step(double time, double dt) {
   for (size_t k = 0; k < w.movingColliders.size(); ++k)
     w.movingColliders[k]->getMotionState()->setWorldTransform(
         toBullet(colliderPose(scene_.colliders[w.movingColliderIndex[k]], time + dt)));
-  for (size_t b = 0; b < states_.size(); ++b) {
-    w.bodies[b]->applyCentralForce(toBullet(states_[b].fluid.force));
-    w.bodies[b]->applyTorque(toBullet(states_[b].fluid.torque));
+  // Bullet steps of at most a millisecond: a body meeting a wall at speed sinks into it by about its speed times
+  // the step before the contact pushes it out, and the water caught between would end inside it. Each is one
+  // step of its own (no time carried over between calls, so a world rebuilt at a frame steps the same).
+  const int pieces = std::max(1, int(std::ceil(dt / kLongestBulletStep - 1e-9)));
+  for (int piece = 0; piece < pieces; ++piece) {
+    for (size_t b = 0; b < states_.size(); ++b) {
+      w.bodies[b]->applyCentralForce(toBullet(states_[b].fluid.force));
+      w.bodies[b]->applyTorque(toBullet(states_[b].fluid.torque));
+    }
+    w.dynamics->stepSimulation(dt / pieces, 0);
   }
-  w.dynamics->stepSimulation(dt, 0);
   long bad = -1;
   for (size_t b = 0; b < states_.size(); ++b) {
     const btRigidBody& body = *w.bodies[b];

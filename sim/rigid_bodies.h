@@ -64,7 +64,8 @@ class RigidBodies {
   std::shared_ptr<const ColliderShapes> shapes_;
   std::vector<BodyState> states_;
   std::vector<MassProperties> mass_;
-  std::vector<Eigen::Matrix3d> principal_;  // shape frame to Bullet's principal frame (columns: axes)
+  std::vector<Eigen::Matrix3d> principal_;
+  std::vector<double> innerRadius_;  // for continuous collision  // shape frame to Bullet's principal frame (columns: axes)
   std::unique_ptr<World> world_;
 };
 

@@ -23,6 +23,7 @@
 #include <cmath>
 #include <fcntl.h>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,11 @@ const char* kBase = R"({
 
 const char* kPlate =
     R"(colliders=[{"name": "plate", "shape": "box", "position": [0.5, 0.15, 0.08], "size": [1.2, 0.02, 0.3]}])";
+// A heavy ball shot into the dam break at 10 m/s and a box a fiftieth of the water's density, dropped onto it.
+const char* kBodies = R"(bodies=[
+    {"name": "shot", "shape": "sphere", "radius": 0.04, "position": [0.8, 0.3, 0.08], "velocity": [-10, -3, 0],
+     "density": 3000},
+    {"name": "cork", "shape": "box", "size": [0.06, 0.06, 0.06], "position": [0.15, 0.42, 0.08], "density": 20}])";
 const char* kPaddle = R"(colliders=[{"name": "paddle", "shape": "box", "size": [0.04, 0.4, 0.3], "motion": [
     {"time": 0, "position": [0.05, 0.2, 0.08]}, {"time": 0.3, "position": [0.95, 0.2, 0.08]}]}])";
 
@@ -113,6 +119,8 @@ std::vector<ExtremeCase> cases() {
        {"fluids=[" + box("[0.3, 0.2, 0]", "[0.6, 0.45, 0.16]", "[0, -30, 0]") + "]", kPlate, "output.frames=6"},
        {"fluids=[" + box("[0.3, 0.2, 0]", "[0.6, 0.45, 0.16]", "[0, -30, 0]") + "]", kPlate, "output.frames=6"}},
       {"PaddleAt3MetresPerSecond", {kPaddle, "output.frames=9"}, {kPaddle, "output.frames=9"}},
+      {"BodiesShotAt10MetresPerSecondAndAFiftiethAsDense", {kBodies, "output.frames=9"},
+       {kBodies, "output.frames=9"}},
       // A 10 x 10 x 10 block at the smallest spacing; 3 frames. WCSPH's CFL step there is about 6 ns (0.4 h / c), so
   // a frame of 1/30 s would take 5.5 million steps (and stop on the frame loop's million-step guard after six
   // minutes): its frames are 1 us, about 170 steps each.
@@ -188,6 +196,61 @@ void expectValidFrame(const ParticleFrame& frame, const Scene& scene, size_t par
   }
 }
 
+// Every body's centre finite and inside the tank in every frame of bodies.csv, and no particle inside a body
+// (closer than 0.45 spacings to it) at the frames written, but within a spacing of a tank wall (see below); the
+// bodies here are a sphere and a box, whose centre of mass is their position.
+void expectValidBodies(const fs::path& out, const Scene& scene, int last) {
+  std::ifstream in(out / "bodies.csv");
+  std::string line;
+  std::getline(in, line);
+  int rows = 0;
+  double deepestAtWalls = INFINITY;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::string cell;
+    std::istringstream fields(line);
+    std::string name;
+    std::getline(fields, cell, ',');
+    const int frame = std::stoi(cell);
+    std::getline(fields, name, ',');
+    while (std::getline(fields, cell, ',')) v.push_back(std::stod(cell));
+    ASSERT_EQ(v.size(), 19u) << line;
+    const Eigen::Vector3d centre(v[0], v[1], v[2]);
+    ASSERT_TRUE(centre.allFinite()) << line;
+    for (int k = 0; k < scene.dimensions; ++k)
+      ASSERT_TRUE(centre[k] >= scene.domain.min[k] && centre[k] <= scene.domain.max[k]) << line;
+    size_t b = 0;
+    while (b < scene.bodies.size() && scene.bodies[b].solid.name != name) ++b;
+    ASSERT_LT(b, scene.bodies.size()) << line;
+    if (frame <= last) {
+      const ColliderShape shape = buildBodyShape(scene, b);
+      Pose pose;
+      pose.translation = centre;
+      pose.rotation = Eigen::Quaterniond(v[3], v[4], v[5], v[6]);
+      const ParticleFrame particles = readParticlePly(framePath(out, "particles", frame, "ply"));
+      for (size_t i = 0; i < particles.size(); ++i) {
+        const Eigen::Vector3d p = particles.position[i].cast<double>();
+        const float d = shape.distance(pose.toLocal(p).cast<float>());
+        // Within a spacing of a tank wall the tank's clamp, applied last so that nothing leaves the tank, takes
+        // precedence over a body that came closer to the wall than a spacing: the particle caught between may
+        // sit inside the body by what the gap lacks of a spacing. Reported, not asserted there.
+        double wall = INFINITY;
+        for (int k = 0; k < scene.dimensions; ++k)
+          wall = std::min({wall, p[k] - scene.domain.min[k], scene.domain.max[k] - p[k]});
+        if (wall < scene.particle_spacing) {
+          deepestAtWalls = std::min(deepestAtWalls, double(d));
+          continue;
+        }
+        ASSERT_GT(d, 0.45 * scene.particle_spacing) << "frame " << frame << ", particle " << i << " inside " << name;
+      }
+    }
+    ++rows;
+  }
+  EXPECT_GE(rows, int(scene.bodies.size()) * (last + 1));
+  std::printf("bodies: closest particle within a spacing of a wall %.2f particle radii from a body\n",
+              deepestAtWalls / (0.5 * scene.particle_spacing));
+}
+
 class Extremes : public testing::TestWithParam<std::tuple<ExtremeCase, std::string>> {};
 
 TEST_P(Extremes, FiniteInsideTheTankOrACleanStop) {
@@ -227,6 +290,7 @@ TEST_P(Extremes, FiniteInsideTheTankOrACleanStop) {
   ASSERT_EQ(frames, expected);
   if (!frames.empty()) particles = readParticlePly(framePath(out, "particles", 0, "ply")).size();
   for (int f : frames) expectValidFrame(readParticlePly(framePath(out, "particles", f, "ply")), scene, particles, f);
+  if (!scene.bodies.empty()) expectValidBodies(out, scene, last);
   fs::remove_all(out);  // the largest case leaves half a gigabyte
 }
 
