@@ -101,15 +101,15 @@ Scene pool(int dimensions, const std::string& bodies, double spacing = 0.02, con
 // a little off the body's faces and is drawn down along them; measured in 3D at s = 0.3: 5.4 mm short at spacing
 // 0.02, 2.7 mm at 0.0125, and 0.5 mm of the first is PBF's compression at 4 iterations), so the 5% holds for
 // boxes at least 6 spacings tall: the boxes here are 0.12 m tall at spacing 0.02.
-void checkDraft(int dimensions, double relative) {
+void checkDraft(int dimensions, double relative, const std::string& method = "pbf") {
   const double height = 0.12;
   const std::string size = dimensions == 3 ? "[0.24, 0.12, 0.24]" : "[0.24, 0.12]";
   const std::string position = dimensions == 3 ? "[0.3, 0.37, 0.3]" : "[0.4, 0.37]";
   Scene scene = pool(dimensions,
                      R"([{"name": "raft", "shape": "box", "position": )" + position + R"(, "size": )" + size +
                          R"(, "density": )" + std::to_string(1000 * relative) + "}]",
-                     0.02, R"(, "output": {"frames": 75})");
-  scene.name += "_draft" + std::to_string(int(relative * 100));
+                     0.02, R"(, "output": {"frames": 75}, "solver": {"method": ")" + method + R"("})");
+  scene.name += "_draft" + std::to_string(int(relative * 100)) + method;
   const fs::path dir = runScene(scene);
   const std::vector<BodyRow> rows = readBodies(dir, "raft");
   ASSERT_EQ(rows.size(), 76u);
@@ -122,8 +122,8 @@ void checkDraft(int dimensions, double relative) {
     ++count;
   }
   draft /= count;
-  std::printf("%dD, s = %.2f: draft %.4f m, expected %.4f m (%.1f%% of the height off)\n", dimensions, relative,
-              draft, relative * height, 100 * (draft - relative * height) / height);
+  std::printf("%s %dD, s = %.2f: draft %.4f m, expected %.4f m (%.1f%% of the height off)\n", method.c_str(),
+              dimensions, relative, draft, relative * height, 100 * (draft - relative * height) / height);
   EXPECT_NEAR(draft, relative * height, 0.05 * height);
   EXPECT_LT(tiltDegrees(rows.back().orientation), 5.0);
 }
@@ -138,6 +138,7 @@ TEST(Bodies, FlatBoxFloatsAtItsDraft2d) {
   checkDraft(2, 0.3);
   checkDraft(2, 0.8);
 }
+
 
 // A ball of density 2000 sinks and stays on the floor: its centre a radius above it (Bullet's contact within a
 // tenth of a spacing), at rest.
@@ -194,6 +195,25 @@ TEST(Bodies, CubeAtHalfDensityTipsOver2d) { checkTipping(2, 0.5, true); }
 TEST(Bodies, CubeAtFifteenPercentStaysFaceDown2d) { checkTipping(2, 0.15, false); }
 TEST(Bodies, CubeAtHalfDensityTipsOver3d) { checkTipping(3, 0.5, true); }
 TEST(Bodies, CubeAtFifteenPercentStaysFaceDown3d) { checkTipping(3, 0.15, false); }
+
+// A body that has stopped still feels the water (peer engines put bodies to sleep after a couple of seconds at
+// rest and they stop responding): a raft floats still for 3 s, then a paddle starts pushing the water towards
+// it, and the raft moves off.
+TEST(Bodies, ABodyAtRestStillFeelsTheWater) {
+  Scene scene = pool(2, R"([{"name": "raft", "shape": "box", "position": [0.6, 0.33], "size": [0.16, 0.08],
+                             "density": 500}])",
+                     0.02, R"(, "colliders": [{"name": "paddle", "shape": "box", "size": [0.04, 0.4],
+                              "motion": [{"time": 3.0, "position": [0.05, 0.2]}, {"time": 3.5, "position": [0.3, 0.2]}]}],
+                              "output": {"frames": 120})");
+  scene.name += "_asleep";
+  const std::vector<BodyRow> rows = readBodies(runScene(scene), "raft");
+  double still = 0, moved = 0;
+  for (int f = 75; f <= 90; ++f) still = std::max(still, rows[f].velocity.norm());
+  for (int f = 90; f <= 120; ++f) moved = std::max(moved, std::abs(rows[f].position.x() - rows[90].position.x()));
+  std::printf("raft at rest: fastest %.4f m/s over 2.5-3 s; moved %.3f m after the paddle started\n", still, moved);
+  EXPECT_LT(still, 0.05);
+  EXPECT_GT(moved, 0.03);
+}
 
 // Without gravity and away from the walls, a ball shot into a blob of water: what the ball loses the water
 // gains. The total momentum of both stays within 2% of the ball's initial momentum over half a second (the

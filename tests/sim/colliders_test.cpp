@@ -67,21 +67,31 @@ float closestApproach(const Solver& solver) {
   return closest;
 }
 
-// Fluid placed inside a collider is removed at set-up: a ball of radius 0.1 in a block of spacing 0.01 holds
-// 4/3 pi 0.1^3 / 0.01^3 = 4189 lattice points, give or take the lattice points within a spacing of its surface
-// (the removal keeps those farther than 0.99 radii of a particle from it, which removes a little more than the
-// ball: a shell of 0.5 spacings, 1.5 x 4 pi 0.1^2 x 0.005 / 0.01^3 ~ 940 more at most).
+// Fluid placed inside a collider is removed at set-up, exactly the lattice points closer to the solid than 0.99
+// of a particle radius (a fluid box drawn against a wall keeps its layer): counted here independently from the
+// lattice and the ball's closed form, |p - c| < r + 0.99 h / 2, and compared point for point with what is
+// kept. A ball of radius 0.1 in a block of spacing 0.01 holds about 4/3 pi 0.1^3 / 0.01^3 = 4189 lattice points
+// and a shell of 0.495 spacings more.
 TEST(Colliders, FluidInsideIsRemoved) {
   const Scene scene = makeScene(3, R"({"min": [0, 0, 0], "max": [0.4, 0.4, 0.4]})",
                                 R"([{"box": {"min": [0, 0, 0], "max": [0.4, 0.4, 0.4]}}])",
                                 R"([{"shape": "sphere", "position": [0.2, 0.2, 0.2], "radius": 0.1}])", 0.01);
   PbfSolver<3> solver(scene);
   size_t removed = 0;
-  withoutInside<3>(scene, solver.colliders(), &removed);
+  const ParticleFrame kept = withoutInside<3>(scene, solver.colliders(), &removed);
+  const ParticleFrame all = initialParticles(scene);
+  const Eigen::Vector3d centre(0.2, 0.2, 0.2);
+  std::vector<Eigen::Vector3f> expected;
+  for (const Eigen::Vector3f& p : all.position)
+    if ((p.cast<double>() - centre).norm() >= 0.1 + 0.99 * 0.005) expected.push_back(p);
+  EXPECT_EQ(removed, all.size() - expected.size());
+  ASSERT_EQ(kept.size(), expected.size());
+  for (size_t i = 0; i < kept.size(); ++i) {
+    ASSERT_EQ(kept.position[i], expected[i]) << "particle " << i;
+    ASSERT_EQ(kept.id[i], uint32_t(i)) << "ids are renumbered";
+  }
   const double ball = 4.0 / 3.0 * M_PI * std::pow(0.1, 3) / std::pow(0.01, 3);
-  const double shell = 4 * M_PI * 0.1 * 0.1 * 0.005 / std::pow(0.01, 3);
   EXPECT_GT(double(removed), ball);
-  EXPECT_LT(double(removed), ball + 1.5 * shell);
 }
 
 // The thin plate: a box one spacing thick across the whole tank (through its walls) under a column of water
