@@ -13,6 +13,7 @@ namespace {
 void renderStage(const Scene& scene, const fs::path& dir, const FrameRange& range,
                  const CommonOptions& options, const RenderOptions& renderOptions) {
   const auto start = std::chrono::steady_clock::now();
+  checkOutputFolder(dir);
   TerminalProgress progress(!options.quiet);
   renderFrames(dir, scene, range, progress, renderOptions);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -53,7 +53,7 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   const std::string previous = existing ? readTextFile(dir / "scene.json") : std::string();
   if (resume && existing && !listFrames(dir, "particles", "ply").empty())
     checkResumable(dir / "scene.json", previous, json);
-  fs::create_directories(dir);
+  checkOutputFolder(dir);
   if (!resume) {
     // A new simulation: whatever the later stages made from an earlier one in this folder is stale (a shorter
     // run would otherwise end in a video of the older run's later frames).

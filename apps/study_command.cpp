@@ -190,7 +190,7 @@ void addStudyCommand(CLI::App& app) {
       overrides.push_back(assignments);
     }
 
-    fs::create_directories(dir);
+    checkOutputFolder(dir);
     writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << sceneToJson(scene); });
     const auto start = std::chrono::steady_clock::now();
     TerminalProgress progress(!common.quiet);

@@ -11,6 +11,7 @@ namespace surge {
 void runSurfaceStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options,
                      bool resume) {
   const auto start = std::chrono::steady_clock::now();
+  checkOutputFolder(dir);
   TerminalProgress progress(!options.quiet);
   surfaceFrames(dir, scene, range, progress, resume);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

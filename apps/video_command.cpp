@@ -10,6 +10,7 @@ namespace surge {
 
 void runVideoStage(const Scene& scene, const fs::path& dir, const CommonOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  checkOutputFolder(dir);
   TerminalProgress progress(!options.quiet);
   makeVideo(dir, scene, progress);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -101,6 +103,21 @@ std::string readTextFile(const fs::path& path) {
   std::stringstream buffer;
   buffer << in.rdbuf();
   return buffer.str();
+}
+
+void checkOutputFolder(const fs::path& dir) {
+  std::error_code error;
+  if (fs::exists(dir, error) && !fs::is_directory(dir, error))
+    throw InputError(dir.string(), "the output folder is a file, not a folder");
+  fs::create_directories(dir, error);
+  if (error) throw InputError(dir.string(), "the output folder cannot be made: " + error.message());
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw InputError(dir.string(), "the output folder cannot be written: " + std::string(std::strerror(errno)));
+  for (auto entry = fs::recursive_directory_iterator(dir, error); !error && entry != fs::recursive_directory_iterator();
+       entry.increment(error))
+    if (entry->is_symlink(error) && fs::is_directory(entry->path(), error))
+      throw InputError(entry->path().string(),
+                       "is a symbolic link to a folder; Surge writes only inside its output folder");
 }
 
 }  // namespace surge

@@ -36,6 +36,11 @@ struct FrameRange {
   static FrameRange parse(const std::string& text);  // throws InputError naming --frames
 };
 
+// Makes `dir` ready to be written by a stage, or throws InputError naming it (one line, exit 2): it must be a
+// folder (made if missing) that can be written, and hold no symbolic link to a folder anywhere inside it, so that
+// a run writes inside the output folder it was given and nowhere else, whatever was planted there.
+void checkOutputFolder(const fs::path& dir);
+
 // Reads a whole text file; throws InputError naming the file if it cannot be read.
 std::string readTextFile(const fs::path& path);
 

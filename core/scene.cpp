@@ -420,6 +420,9 @@ void validateSolids(Scene& s, const std::string& where) {
 }
 
 void validate(Scene& s, const std::string& where) {
+  // The default output folder is out/<name>: a scene file must not choose where Surge writes.
+  if (!isPlainName(s.name))
+    throw InputError(where, "name", "must be a plain file name: letters, digits, '-', '_' or '.', not starting with '.'");
   const int d = s.dimensions;
   for (int k = 0; k < d; ++k)
     if (!(s.domain.min[k] < s.domain.max[k]))
