@@ -120,7 +120,9 @@ void visitBody(SceneVisitor& v, BodySettings& b) {
 }  // namespace
 
 void visitScene(Scene& s, SceneVisitor& v) {
-  v.text("name", s.name, required("the scene's name, a plain file name (letters, digits, -, _, ., not starting with .); the default output folder is out/<name>"));
+  v.text("name", s.name,
+         required("the scene's name, a plain file name (letters, digits, -, _, ., not starting with .); the "
+                  "default output folder is out/<name>"));
   {
     FieldInfo dims = required("2 or 3; in 2D every vector has two components");
     dims.min = 2;
