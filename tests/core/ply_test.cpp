@@ -26,6 +26,7 @@ TEST(Ply, ParticleFrameRoundTripsBitForBit) {
     frame.id[i] = 100 + i;
   }
   const fs::path path = tempPath("particles.ply");
+  for (const auto& entry : fs::directory_iterator(path.parent_path())) fs::remove_all(entry.path());
   writeParticlePly(path, frame);
   const ParticleFrame back = readParticlePly(path);
   EXPECT_EQ(back.dimensions, 2);
@@ -41,7 +42,14 @@ TEST(Ply, ParticleFrameRoundTripsBitForBit) {
   std::string start(header.size(), '\0');
   in.read(start.data(), static_cast<std::streamsize>(start.size()));
   EXPECT_EQ(start, header);
-  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+  const std::string bytes = readTextFile(path);
+  const size_t body = bytes.find("end_header\n");
+  ASSERT_NE(body, std::string::npos);
+  EXPECT_EQ(bytes.size() - (body + std::string("end_header\n").size()), 3u * 28u);
+  // The temporary file the write went through (its name carries the process id) is gone: the folder holds the
+  // frame alone.
+  for (const auto& entry : fs::directory_iterator(path.parent_path()))
+    EXPECT_EQ(entry.path().filename().string().rfind("particles.ply.tmp", 0), std::string::npos) << entry.path();
 }
 
 TEST(Ply, MeshRoundTrips) {
