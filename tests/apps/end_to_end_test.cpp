@@ -1,5 +1,8 @@
 // Runs the `surge` program as a user would and reads back every stage's files.
 #include <gtest/gtest.h>
+
+#include <set>
+#include <tuple>
 #include <stb/stb_image.h>
 
 #include <array>
@@ -51,6 +54,17 @@ TEST(EndToEnd, RunMakesEveryStagesFiles) {
   // Frame 0 is the lattice at rest; the water has moved by frame 3 (it falls and spreads under gravity).
   const ParticleFrame first = readParticlePly(framePath(out, "particles", 0, "ply"));
   const ParticleFrame last = readParticlePly(framePath(out, "particles", 3, "ply"));
+  // The lattice at rest: every particle at a cell centre (i + 1/2) 0.03 of the box, not moving.
+  std::set<std::tuple<int, int, int>> cells;
+  for (size_t i = 0; i < first.size(); ++i) {
+    const Eigen::Vector3f cell = first.position[i] / 0.03f - Eigen::Vector3f::Constant(0.5f);
+    const Eigen::Vector3f nearest = cell.array().round();
+    EXPECT_LT((cell - nearest).norm(), 1e-4f) << "particle " << i;
+    EXPECT_EQ(first.velocity[i], Eigen::Vector3f::Zero()) << "particle " << i;
+    cells.insert({int(nearest.x()), int(nearest.y()), int(nearest.z())});
+  }
+  EXPECT_EQ(cells.size(), particles);  // each cell once
+  for (const auto& [i, j, k] : cells) EXPECT_TRUE(i >= 0 && i < 6 && j >= 0 && j < 8 && k >= 0 && k < 5);
   float speed = 0;
   for (const auto& v : last.velocity) speed = std::max(speed, v.norm());
   EXPECT_GT(speed, 0.05f);
