@@ -19,8 +19,9 @@ std::vector<std::vector<uint32_t>> bruteForce(const std::vector<Vec<Dim>>& x, fl
 }
 
 template <int Dim>
-void expectSameAsBruteForce(std::vector<Vec<Dim>> x, const Vec<Dim>& lo, const Vec<Dim>& hi, float h) {
-  NeighborGrid<Dim> grid(lo, hi, h);
+void expectSameAsBruteForceWithCells(std::vector<Vec<Dim>> x, const Vec<Dim>& lo, const Vec<Dim>& hi, float h,
+                                     float cell) {
+  NeighborGrid<Dim> grid(lo, hi, cell);
   grid.sort(x);
   std::vector<Vec<Dim>> sorted, scratch;
   sorted = x;
@@ -40,6 +41,16 @@ void expectSameAsBruteForce(std::vector<Vec<Dim>> x, const Vec<Dim>& lo, const V
     pairs += got.size();
   }
   EXPECT_GT(pairs, 0u);
+}
+
+// Checked with cells as wide as the radius (3 cells a side searched) and half as wide (5 a side, as both solvers
+// use).
+template <int Dim>
+void expectSameAsBruteForce(const std::vector<Vec<Dim>>& x, const Vec<Dim>& lo, const Vec<Dim>& hi, float h) {
+  for (float cell : {h, 0.5f * h}) {
+    SCOPED_TRACE("cells of " + std::to_string(cell));
+    expectSameAsBruteForceWithCells<Dim>(x, lo, hi, h, cell);
+  }
 }
 
 TEST(NeighborGrid, MatchesBruteForceOnRandomPoints) {
