@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "bench/bench_timing.h"
 #include "core/parallel.h"
 #include "sim/pbf_solver.h"
 #include "sim/rigid_bodies.h"
@@ -16,10 +17,6 @@
 
 namespace surge {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 Scene pool(const std::string& bodies) {
   return parseScene(R"({"name": "bench", "dimensions": 3, "domain": {"min": [0, 0, 0], "max": [0.6, 0.5, 0.6]},
@@ -69,7 +66,7 @@ int main(int argc, char** argv) {
   double time = 0;
   // Steps of the coupled pool, a frame (substeps steps) at a time, as the frame loop takes them.
   auto coupledFrames = [&](int frames) {
-    const auto start = Clock::now();
+    const auto start = BenchClock::now();
     for (int f = 0; f < frames; ++f) {
       bodies.beginFrame(time);
       placeBodies(bodies, with.colliders());
@@ -91,7 +88,7 @@ int main(int argc, char** argv) {
     with.getParticles(state);
     without.setParticles(state);
     double t0 = time;
-    const auto start = Clock::now();
+    const auto start = BenchClock::now();
     for (int s = 0; s < 2 * substeps; ++s, t0 += dt) without.step(dt, t0);
     bestWithout = std::min(bestWithout, secondsSince(start) / (2 * substeps));
     bestWith = std::min(bestWith, coupledFrames(2));

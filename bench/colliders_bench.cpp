@@ -12,16 +12,13 @@
 #include <cstdlib>
 #include <fstream>
 
+#include "bench/bench_timing.h"
 #include "core/parallel.h"
 #include "sim/pbf_solver.h"
 #include "sim/simulation.h"
 
 namespace surge {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // A torus about the y axis (major radius R, minor r), u x v quads as 2 u v triangles, written as OBJ.
 void writeTorusObj(const fs::path& path, double major, double minor, int u, int v) {
@@ -50,7 +47,7 @@ Scene pool(const std::string& colliders) {
 template <typename Solver>
 double timeSteps(Solver& solver, int steps, double& time) {
   const float dt = 1.0f / 120;
-  const auto start = Clock::now();
+  const auto start = BenchClock::now();
   for (int s = 0; s < steps; ++s) {
     solver.step(dt, time);
     time += dt;
@@ -71,7 +68,7 @@ int main(int argc, char** argv) {
       R"([{"name": "torus", "shape": "mesh", "file": ")" + obj.string() + R"(", "position": [0.3, 0.1, 0.3]}])";
   const Scene withMesh = pool(collider);
 
-  auto start = Clock::now();
+  auto start = BenchClock::now();
   const std::shared_ptr<const ColliderShapes> shapes = buildColliderShapes(withMesh);
   const double bake = secondsSince(start);
   const ColliderShape& torus = shapes->front();

@@ -11,9 +11,12 @@
 #include <cstdlib>
 #include <string>
 
+#include "bench/bench_timing.h"
 #include "core/parallel.h"
 #include "render/rasterizer.h"
 #include "render/renderer.h"
+
+using surge::secondsSince;
 
 namespace {
 
@@ -66,10 +69,6 @@ TriangleMesh waveMesh() {
     mesh.triangles.push_back({a0, b0, centre});
   }
   return mesh;
-}
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace

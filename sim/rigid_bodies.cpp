@@ -58,6 +58,16 @@ struct RigidBodies::World {
     shapes.emplace_back(shape);
     return shape;
   }
+  // A box, sphere, capsule or cylinder (along y) as Bullet's own shape, scaled.
+  btCollisionShape* primitive(const ColliderShape& shape, double scale, double margin) {
+    const double r = scale * shape.radius, h = scale * shape.halfHeight;
+    switch (shape.kind) {
+      case ShapeKind::Box: return keep(new btBoxShape(toBullet(scale * shape.halfExtents.cast<double>())), margin);
+      case ShapeKind::Sphere: return keep(new btSphereShape(r), margin);
+      case ShapeKind::Capsule: return keep(new btCapsuleShape(r, 2 * h), margin);
+      default: return keep(new btCylinderShape(btVector3(r, h, r)), margin);
+    }
+  }
   btCollisionShape* triangleMesh(const TriangleMesh& mesh, double scale, double margin) {
     auto soup = std::make_unique<btTriangleMesh>();
     for (const auto& t : mesh.triangles)
@@ -120,15 +130,8 @@ RigidBodies::RigidBodies(const Scene& scene, std::shared_ptr<const ColliderShape
       s = w.keep(new btStaticPlaneShape(toBullet(shape.planeNormal.cast<double>()), 0), margin);
     } else if (shape.container || shape.kind == ShapeKind::Heightfield || shape.kind == ShapeKind::Mesh) {
       s = w.triangleMesh(shape.mesh, scale, margin);
-    } else if (shape.kind == ShapeKind::Box) {
-      s = w.keep(new btBoxShape(toBullet(scale * shape.halfExtents.cast<double>())), margin);
-    } else if (shape.kind == ShapeKind::Sphere) {
-      s = w.keep(new btSphereShape(scale * shape.radius), margin);
-    } else if (shape.kind == ShapeKind::Capsule) {
-      s = w.keep(new btCapsuleShape(scale * shape.radius, 2 * scale * shape.halfHeight), margin);
     } else {
-      s = w.keep(new btCylinderShape(btVector3(scale * shape.radius, scale * shape.halfHeight, scale * shape.radius)),
-                 margin);
+      s = w.primitive(shape, scale, margin);
     }
     w.colliderShapes.push_back(s);
   }
@@ -137,9 +140,10 @@ RigidBodies::RigidBodies(const Scene& scene, std::shared_ptr<const ColliderShape
     const BodySettings& settings = scene.bodies[b];
     const ColliderShape& shape = (*shapes_)[first + b];
     const double scale = settings.solid.scale;
-    MassProperties unit = surge::massProperties(shape, scale, scene.dimensions, 1.0);
-    const double density = settings.density > 0 ? settings.density : settings.mass / unit.volume;
-    MassProperties m = surge::massProperties(shape, scale, scene.dimensions, density);
+    MassProperties m = surge::massProperties(shape, scale, scene.dimensions, 1.0);
+    const double density = settings.density > 0 ? settings.density : settings.mass / m.volume;
+    m.mass *= density;  // mass and inertia are linear in the density
+    m.inertia *= density;
     Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
     if (shape.kind == ShapeKind::Mesh) {
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(m.inertia);
@@ -148,16 +152,8 @@ RigidBodies::RigidBodies(const Scene& scene, std::shared_ptr<const ColliderShape
       m.inertia = eigen.eigenvalues().asDiagonal();
     }
     btCollisionShape* s = nullptr;
-    if (shape.kind == ShapeKind::Box) {
-      Eigen::Vector3d half = scale * shape.halfExtents.cast<double>();
-      s = w.keep(new btBoxShape(toBullet(half)), margin);
-    } else if (shape.kind == ShapeKind::Sphere) {
-      s = w.keep(new btSphereShape(scale * shape.radius), margin);
-    } else if (shape.kind == ShapeKind::Capsule) {
-      s = w.keep(new btCapsuleShape(scale * shape.radius, 2 * scale * shape.halfHeight), margin);
-    } else if (shape.kind == ShapeKind::Cylinder) {
-      s = w.keep(new btCylinderShape(btVector3(scale * shape.radius, scale * shape.halfHeight, scale * shape.radius)),
-                 margin);
+    if (shape.kind != ShapeKind::Mesh) {
+      s = w.primitive(shape, scale, margin);
     } else {
       // A mesh collides as its convex hull, in the principal frame about the centre of mass.
       auto* hull = new btConvexHullShape();

@@ -117,13 +117,16 @@ std::string colliderRows(const Scene& scene, int frame, const std::vector<Wrench
   return rows;
 }
 
-// A collider's mesh placed in the world at `time`.
-TriangleMesh placedMesh(const ColliderSettings& settings, const ColliderShape& shape, double time) {
-  const Pose pose = colliderPose(settings, time);
-  TriangleMesh mesh = shape.mesh;
+// A shape's mesh placed in the world by `pose`.
+TriangleMesh placedMesh(TriangleMesh mesh, const Pose& pose) {
   for (Eigen::Vector3f& p : mesh.positions) p = pose.toWorld(p.cast<double>()).cast<float>();
   for (Eigen::Vector3f& n : mesh.normals) n = (pose.rotation * n.cast<double>()).cast<float>();
   return mesh;
+}
+
+// A collider's mesh placed in the world at `time`.
+TriangleMesh placedMesh(const ColliderSettings& settings, const ColliderShape& shape, double time) {
+  return placedMesh(shape.mesh, colliderPose(settings, time));
 }
 
 // colliders/<name>.ply: each collider's mesh in the world as it stands at time 0, so that the later stages and
@@ -177,10 +180,7 @@ void writeBodyFrame(const Scene& scene, const ColliderShapes& shapes, const Rigi
                     const fs::path& dir, int frame) {
   const fs::path folder = dir / "bodies";
   for (size_t b = 0; b < bodies.size(); ++b) {
-    const Pose pose = bodies.pose(b);
-    TriangleMesh mesh = shapes[scene.colliders.size() + b].mesh;
-    for (Eigen::Vector3f& p : mesh.positions) p = pose.toWorld(p.cast<double>()).cast<float>();
-    for (Eigen::Vector3f& n : mesh.normals) n = (pose.rotation * n.cast<double>()).cast<float>();
+    const TriangleMesh mesh = placedMesh(shapes[scene.colliders.size() + b].mesh, bodies.pose(b));
     const std::string& name = scene.bodies[b].solid.name;
     fs::create_directories(folder / name);
     if (frame == 0) writeMeshPly(folder / (name + ".ply"), mesh);
