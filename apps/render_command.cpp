@@ -51,6 +51,8 @@ void addRenderCommand(CLI::App& app) {
       ->check(CLI::IsMember({"preview", "standard", "final"}));
   command->add_flag("--particles", options->render.particles,
                     "gl: draw the particles as spheres (the default when there are no surface frames)");
+  command->add_flag("--resume", options->render.resume,
+                    "leave the frames already up to date (newer than their surfaces and the render settings)");
   addCommonOptions(*command, options->common, false);
   command->callback([options] {
     Scene scene = sceneOfFolder(options->dir, options->common);

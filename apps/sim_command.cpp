@@ -35,7 +35,27 @@ void checkResumable(const fs::path& previous, const std::string& previousJson, c
 
 }  // namespace
 
+void removeLaterStagesFrames(const fs::path& dir) {
+  // A new simulation: whatever the later stages made from an earlier one in this folder is stale (a shorter run
+  // would otherwise end in a video of the older run's later frames).
+  removeFrames(dir, "surface", {"vdb", "ply", "obj"});
+  removeFrames(dir, "frames", {"png"});
+}
+
+void writeSimStatus(const fs::path& dir, const std::string& status) {
+  writeFileAtomically(dir / "sim_status.txt", [&](std::ostream& out) { out << status << "\n"; });
+}
+
+std::string readSimStatus(const fs::path& dir) {
+  std::error_code error;
+  if (!fs::exists(dir / "sim_status.txt", error)) return "";
+  std::string text = readTextFile(dir / "sim_status.txt");
+  while (!text.empty() && text.back() == '\n') text.pop_back();
+  return text;
+}
+
 void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const CommonOptions& options) {
+  checkSimulationMemory(scene);
   // The colliders' and bodies' files are read (and refused if bad), and bodies overlapping at the start are
   // refused, before anything is written.
   const std::shared_ptr<const ColliderShapes> shapes = buildColliderShapes(scene);
@@ -54,17 +74,23 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   if (resume && existing && !listFrames(dir, "particles", "ply").empty())
     checkResumable(dir / "scene.json", previous, json);
   checkOutputFolder(dir);
-  if (!resume) {
-    // A new simulation: whatever the later stages made from an earlier one in this folder is stale (a shorter
-    // run would otherwise end in a video of the older run's later frames).
-    removeFrames(dir, "surface", {"vdb", "ply", "obj"});
-    removeFrames(dir, "frames", {"png"});
-  }
+  if (!resume) removeLaterStagesFrames(dir);
   // Rewritten only when it changes: its time tells the later stages' --resume whether their frames are stale.
   if (!existing || previous != json)
     writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << json; });
   TerminalProgress progress(!options.quiet);
-  const SimulationSummary summary = simulate(scene, shapes, dir, resume, progress);
+  writeSimStatus(dir, "running");
+  SimulationSummary summary;
+  try {
+    summary = simulate(scene, shapes, dir, resume, progress);
+  } catch (const Interrupted&) {
+    writeSimStatus(dir, "stopped");
+    throw;
+  } catch (const std::exception& e) {
+    writeSimStatus(dir, std::string("failed: ") + e.what());
+    throw;
+  }
+  writeSimStatus(dir, "finished");
   if (summary.removedParticles > 0)
     say(options, "sim: removed " + std::to_string(summary.removedParticles) +
                      " fluid particles placed inside " + (scene.bodies.empty() ? "colliders" : "colliders and bodies"));

@@ -45,6 +45,12 @@ struct StudyRun {
   double frontRms = 0, heightRms = 0, fieldError = 0, error = 0;
 };
 
+// The run's measures (status, message, CPU and wall seconds, peak memory) as run.json in its folder, written by
+// the task that ran it and read by the report (surge study --slurm runs them in different jobs). A run without
+// one reads as failed, "did not run".
+void writeRunRecord(const StudyRun& run);
+void readRunRecord(StudyRun& run);
+
 // Reads the run's stats.csv into it (the columns are found by name). A run that stopped early keeps its rows.
 void readRunStats(StudyRun& run);
 

@@ -18,6 +18,7 @@
 #include <fstream>
 
 #include "apps/commands.h"
+#include "apps/slurm.h"
 #include "apps/study.h"
 #include "core/errors.h"
 #include "sim/simulation.h"
@@ -152,6 +153,9 @@ void addStudyCommand(CLI::App& app) {
     std::string scene;
     std::vector<std::string> sweeps;
     int frames = 0;
+    int runIndex = -1;
+    bool report = false;
+    SlurmOptions slurm;
   };
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand(
@@ -162,7 +166,15 @@ void addStudyCommand(CLI::App& app) {
       ->required();
   command->add_option("--frames", options->frames, "output frames per run (default: the scene's output.frames)")
       ->check(CLI::PositiveNumber);
+  command->add_option("--run-index", options->runIndex,
+                      "run only the sweep point of this index (0-based) into its runs/ folder, no report (a Slurm "
+                      "array task of surge study --slurm)")
+      ->check(CLI::NonNegativeNumber);
+  command->add_flag("--report", options->report,
+                    "run nothing: write study.csv and the plots from the runs already in the folder (the last job "
+                    "of surge study --slurm)");
   addCommonOptions(*command, options->common, true);
+  addSlurmOptions(*command, options->slurm, false);
   command->callback([options] {
     const CommonOptions& common = options->common;
     std::vector<Sweep> sweeps;
@@ -181,7 +193,7 @@ void addStudyCommand(CLI::App& app) {
     for (const std::vector<std::string>& values : combinations(sweeps)) {
       std::vector<std::string> assignments = base;
       for (size_t s = 0; s < sweeps.size(); ++s) assignments.push_back(sweeps[s].key + "=" + values[s]);
-      loadScene(options->scene, assignments);
+      checkSimulationMemory(loadScene(options->scene, assignments));
       StudyRun run;
       run.index = static_cast<int>(runs.size());
       run.values = values;
@@ -190,14 +202,48 @@ void addStudyCommand(CLI::App& app) {
       overrides.push_back(assignments);
     }
 
+    if (options->runIndex >= int(runs.size()))
+      throw InputError("--run-index", std::to_string(options->runIndex) + " is past the last of the " +
+                                          std::to_string(runs.size()) + " sweep points");
+    if (options->slurm.enabled) {
+      // Each task runs this same command (absolute paths, the same sweeps and settings) with --run-index.
+      const fs::path absolute = fs::absolute(dir);
+      std::vector<std::string> arguments = {fs::absolute(options->scene).string(), "--out", absolute.string()};
+      for (const std::string& sweep : options->sweeps) arguments.insert(arguments.end(), {"--sweep", sweep});
+      if (options->frames > 0) arguments.insert(arguments.end(), {"--frames", std::to_string(options->frames)});
+      for (const std::string& assignment : common.overrides) arguments.insert(arguments.end(), {"--set", assignment});
+      arguments.push_back("--quiet");
+      if (!options->slurm.dryRun) {
+        checkOutputFolder(absolute);
+        writeFileAtomically(absolute / "scene.json", [&](std::ostream& out) { out << sceneToJson(scene); });
+      }
+      submitJobs(studyJobs(scene.name, absolute, int(runs.size()), arguments, options->slurm), absolute,
+                 options->slurm, common);
+      return;
+    }
     checkOutputFolder(dir);
-    writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << sceneToJson(scene); });
+    if (options->runIndex >= 0) {
+      StudyRun& run = runs[size_t(options->runIndex)];
+      runOne(run, options->scene, overrides[size_t(options->runIndex)], common.threads);
+      writeRunRecord(run);
+      say(common, "study: run " + std::to_string(run.index) + " " + run.status + " in " +
+                      std::to_string(run.cpuSeconds) + " CPU s -> " + run.folder.string());
+      return;
+    }
+    if (!options->report)
+      writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << sceneToJson(scene); });
     const auto start = std::chrono::steady_clock::now();
     TerminalProgress progress(!common.quiet);
     progress.start("study", runs.size());
     for (size_t i = 0; i < runs.size(); ++i) {
       Progress::checkInterrupt();
-      runOne(runs[i], options->scene, overrides[i], common.threads);
+      if (options->report) {
+        readRunRecord(runs[i]);
+        readRunStats(runs[i]);
+      } else {
+        runOne(runs[i], options->scene, overrides[i], common.threads);
+        writeRunRecord(runs[i]);
+      }
       progress.advance();
     }
     progress.finish();

@@ -15,6 +15,8 @@
 #include <sstream>
 
 #include "apps/study.h"
+
+#include <nlohmann/json.hpp>
 #include "core/errors.h"
 #include "core/ply.h"
 #include "sim/simulation.h"
@@ -105,6 +107,30 @@ std::string label(const StudyRun& run) {
 }
 
 }  // namespace
+
+void writeRunRecord(const StudyRun& run) {
+  const nlohmann::json record = {{"status", run.status},           {"message", run.message},
+                                 {"cpu_seconds", run.cpuSeconds},   {"wall_seconds", run.wallSeconds},
+                                 {"peak_megabytes", run.peakMegabytes}};
+  writeFileAtomically(run.folder / "run.json", [&](std::ostream& out) { out << record.dump(2) << "\n"; });
+}
+
+void readRunRecord(StudyRun& run) {
+  std::error_code error;
+  if (!fs::exists(run.folder / "run.json", error)) {
+    run.status = "failed";
+    run.message = "did not run (no " + (run.folder / "run.json").string() + ")";
+    return;
+  }
+  const nlohmann::json record = nlohmann::json::parse(readTextFile(run.folder / "run.json"), nullptr, false);
+  if (record.is_discarded() || !record.is_object())
+    throw InputError((run.folder / "run.json").string(), "is not the JSON surge study writes");
+  run.status = record.value("status", "failed");
+  run.message = record.value("message", "");
+  run.cpuSeconds = record.value("cpu_seconds", 0.0);
+  run.wallSeconds = record.value("wall_seconds", 0.0);
+  run.peakMegabytes = record.value("peak_megabytes", 0.0);
+}
 
 void readRunStats(StudyRun& run) {
   std::ifstream in(run.folder / "stats.csv");

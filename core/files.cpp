@@ -39,22 +39,44 @@ fs::path framePath(const fs::path& dir, const std::string& sub, int frame, const
   return dir / sub / name;
 }
 
+namespace {
+
+// The frame number of a file name framePath writes (frame_ and five digits or more, then .ext), or -1: frames
+// above 99,999 take six or seven digits; a name framePath would not write (frame_0123456.ply) is not a frame.
+int frameNumber(const std::string& name, const std::string& ext) {
+  const std::string suffix = "." + ext;
+  if (name.size() <= 6 + suffix.size() || name.rfind("frame_", 0) != 0) return -1;
+  if (name.compare(name.size() - suffix.size(), std::string::npos, suffix) != 0) return -1;
+  const std::string digits = name.substr(6, name.size() - 6 - suffix.size());
+  if (digits.size() < 5 || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), ::isdigit)) return -1;
+  const int frame = std::stoi(digits);
+  return framePath("", "", frame, ext).filename() == name ? frame : -1;
+}
+
+}  // namespace
+
 std::vector<int> listFrames(const fs::path& dir, const std::string& sub, const std::string& ext) {
   std::vector<int> frames;
   const fs::path folder = dir / sub;
   std::error_code error;
   if (!fs::is_directory(folder, error)) return frames;
-  const std::string suffix = "." + ext;
-  for (const auto& entry : fs::directory_iterator(folder)) {
-    const std::string name = entry.path().filename().string();
-    if (name.size() != 11 + suffix.size() || name.rfind("frame_", 0) != 0) continue;
-    if (name.compare(11, std::string::npos, suffix) != 0) continue;
-    const std::string digits = name.substr(6, 5);
-    if (!std::all_of(digits.begin(), digits.end(), ::isdigit)) continue;
-    frames.push_back(std::stoi(digits));
-  }
+  for (const auto& entry : fs::directory_iterator(folder))
+    if (const int frame = frameNumber(entry.path().filename().string(), ext); frame >= 0) frames.push_back(frame);
   std::sort(frames.begin(), frames.end());
   return frames;
+}
+
+void removeTemporaries(const fs::path& dir, const std::string& sub, const std::string& ext, const FrameRange& range) {
+  const fs::path folder = dir / sub;
+  std::error_code error;
+  if (!fs::is_directory(folder, error)) return;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    const std::string name = entry.path().filename().string();
+    const size_t tmp = name.rfind(".tmp");
+    if (tmp == std::string::npos) continue;
+    const int frame = frameNumber(name.substr(0, tmp), ext);
+    if (frame >= 0 && range.contains(frame)) fs::remove(entry.path(), error);
+  }
 }
 
 void removeFrames(const fs::path& dir, const std::string& sub, const std::vector<std::string>& exts) {

@@ -15,14 +15,20 @@ namespace fs = std::filesystem;
 // old file or the whole new one. On any exception the temporary file is removed and the exception rethrown.
 void writeFileAtomically(const fs::path& path, const std::function<void(std::ostream&)>& write);
 
-// dir/sub/frame_NNNNN.ext (five digits).
+// dir/sub/frame_NNNNN.ext: five digits, more for frames above 99,999 (output.frames reaches 10^7).
 fs::path framePath(const fs::path& dir, const std::string& sub, int frame, const std::string& ext);
 
-// The frame numbers of the dir/sub/frame_NNNNN.ext files present, sorted.
+// The frame numbers of the dir/sub/frame_NNNNN.ext files present (any number of digits framePath writes), sorted.
 std::vector<int> listFrames(const fs::path& dir, const std::string& sub, const std::string& ext);
 
 // Removes every dir/sub/frame_NNNNN.ext, for each of `exts`.
 void removeFrames(const fs::path& dir, const std::string& sub, const std::vector<std::string>& exts);
+
+struct FrameRange;
+// Removes what a killed run left of the frames in `range`: dir/sub/frame_NNNNN.ext.tmpPID, the temporaries of
+// writeFileAtomically. A stage calls it for its own frames only, so that a task writing other frames beside it
+// (a Slurm array task) keeps its own.
+void removeTemporaries(const fs::path& dir, const std::string& sub, const std::string& ext, const FrameRange& range);
 
 // Whether every one of `outputs` exists and none is older than any of `inputs`: a frame made from these inputs
 // by an earlier run that stopped later (`surge run --resume` skips it; the bytes would be the same).

@@ -4,6 +4,8 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -441,12 +443,6 @@ void validate(Scene& s, const std::string& where) {
   if (count == 0)
     throw InputError(where, "fluids",
                      "the fluid boxes hold no particles at particle_spacing " + formatNumber(spacing));
-  const double bytes = double(count) * double(bytesPerParticleEstimate(d));
-  const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
-  if (count > (size_t(1) << 31) || bytes > 0.8 * memory)
-    throw InputError(where, "particle_spacing",
-                     std::to_string(count) + " particles need about " + formatNumber(std::ceil(bytes / 1e9)) +
-                         " GB, more than this machine's " + formatNumber(std::floor(memory / 1e9)) + " GB");
 
   SolverSettings& solver = s.solver;
   if (solver.substeps == 0) solver.substeps = std::max(4, stableSubsteps(s));
@@ -600,11 +596,71 @@ Scene loadScene(const fs::path& path, const std::vector<std::string>& overrides)
   return scene;
 }
 
+MemoryLimit memoryLimit() {
+  MemoryLimit limit{double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE)), "this machine's"};
+  auto lower = [&](double bytes, const char* source) {
+    if (bytes > 0 && bytes < limit.bytes) limit = {bytes, source};
+  };
+  // A number of bytes in a file ("max" or a huge value means no limit).
+  auto fileBytes = [](const char* path) {
+    std::ifstream in(path);
+    std::string text;
+    if (!(in >> text) || text.empty() || !std::isdigit(static_cast<unsigned char>(text[0]))) return 0.0;
+    return std::strtod(text.c_str(), nullptr);
+  };
+  lower(fileBytes("/sys/fs/cgroup/memory.max"), "this cgroup's");                        // cgroup v2
+  lower(fileBytes("/sys/fs/cgroup/memory/memory.limit_in_bytes"), "this cgroup's");      // cgroup v1
+  auto environment = [](const char* name) {
+    const char* value = std::getenv(name);
+    return value ? std::strtod(value, nullptr) : 0.0;
+  };
+  // Slurm's --mem and --mem-per-cpu, in MB, which hold even where Slurm does not enforce them with cgroups.
+  lower(environment("SLURM_MEM_PER_NODE") * 1048576.0, "this Slurm job's");
+  lower(environment("SLURM_MEM_PER_CPU") * 1048576.0 * std::max(1.0, environment("SLURM_CPUS_ON_NODE")),
+        "this Slurm job's");
+  return limit;
+}
+
+void checkSimulationMemory(const Scene& scene) {
+  const size_t count = scene.particleCount();
+  const double bytes = double(count) * double(bytesPerParticleEstimate(scene.dimensions));
+  const MemoryLimit memory = memoryLimit();
+  auto size = [](double b) {
+    char text[32];
+    std::snprintf(text, sizeof text, b >= 1e9 ? "%.1f GB" : "%.1f MB", b >= 1e9 ? b / 1e9 : b / 1e6);
+    return std::string(text);
+  };
+  if (count > (size_t(1) << 31) || bytes > 0.8 * memory.bytes)
+    throw InputError(scene.source, "particle_spacing",
+                     std::to_string(count) + " particles need about " + size(bytes) + " to simulate, more than " +
+                         memory.source + " " + size(memory.bytes) + " allow (80%)");
+}
+
 std::string sceneToJson(const Scene& scene) {
   Scene copy = scene;
   JsonWriter writer(copy);
   visitScene(copy, writer);
   return writer.root().dump(2) + "\n";
+}
+
+fs::path writeStageSettings(const fs::path& dir, const std::string& stage, const Scene& scene,
+                            const std::string& extra) {
+  std::vector<const char*> keys = {"dimensions", "domain", "particle_spacing", "colliders", "bodies"};
+  if (stage == "surface" || stage == "render") keys.push_back(stage.c_str());
+  else throw std::logic_error("writeStageSettings: no stage '" + stage + "'");
+  Scene copy = scene;
+  JsonWriter writer(copy);
+  visitScene(copy, writer);
+  json settings = json::object();
+  for (const char* key : keys)
+    if (writer.root().contains(key)) settings[key] = writer.root()[key];
+  settings["options"] = json::parse(extra);
+  const std::string text = settings.dump(2) + "\n";
+  const fs::path path = dir / (stage + "_settings.json");
+  std::error_code error;
+  if (!fs::exists(path, error) || readTextFile(path) != text)
+    writeFileAtomically(path, [&](std::ostream& out) { out << text; });
+  return path;
 }
 
 std::string sceneKeysMarkdown() {

@@ -204,10 +204,33 @@ Scene parseScene(const std::string& text, const std::string& where,
 // The scene as JSON text with every key (the resolved scene saved as scene.json in the output folder).
 std::string sceneToJson(const Scene& scene);
 
+// The settings a later stage reads, as dir/<stage>_settings.json ("surface" or "render"), with `extra` (the
+// stage's own options, a JSON object) added; the file is rewritten only when they change, so that its time says
+// when they last did. Each frame a stage makes is up to date when it is newer than its inputs and this file, so
+// a changed render setting leaves the surfaces up to date, and a changed surface setting the physics.
+//   surface: dimensions, domain, particle_spacing, surface, colliders, bodies
+//   render:  dimensions, domain, particle_spacing, render, colliders, bodies
+fs::path writeStageSettings(const fs::path& dir, const std::string& stage, const Scene& scene,
+                            const std::string& extra = "{}");
+
 // A markdown table of every key: path, type, default, allowed values, meaning.
 std::string sceneKeysMarkdown();
 
 // Bytes the simulator needs per particle at peak, for the memory check and for reporting.
 size_t bytesPerParticleEstimate(int dimensions);
+
+// The memory this process may use: the least of the machine's physical memory, its cgroup's limit (v2
+// memory.max, v1 memory.limit_in_bytes) and a Slurm job's (SLURM_MEM_PER_NODE, or SLURM_MEM_PER_CPU times
+// SLURM_CPUS_ON_NODE), and which of them it is ("this machine's", "this cgroup's", "this Slurm job's").
+struct MemoryLimit {
+  double bytes = 0;
+  std::string source;
+};
+MemoryLimit memoryLimit();
+
+// Refuses (InputError naming scene.source and particle_spacing) a scene whose particles would need more than
+// 80% of memoryLimit() to simulate, or more than 2^31 of them. Only the simulation asks: surfacing and
+// rendering read frames one at a time, and a render node may have less memory than the simulation needed.
+void checkSimulationMemory(const Scene& scene);
 
 }  // namespace surge

@@ -138,13 +138,18 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
                          std::to_string(all.back()) + ")");
   // The standing colliders are read here once, a moving one's mesh with each frame.
   ColliderMeshes colliders(dir, scene);
+  removeTemporaries(dir, "frames", "png", range);
+  // Written before any frame, so that every frame made with these settings is newer than it.
+  const fs::path settings = writeStageSettings(
+      dir, "render", scene,
+      std::string("{\"renderer\": \"") + renderer + "\", \"particles\": " + (particles ? "true" : "false") + "}");
   if (options.resume) {
     // A moving collider's frame file is an input of the image too; its <name>.ply is not, as the simulation
     // writes it again when it resumes.
     const auto done = [&](int f) {
       std::vector<fs::path> inputs = colliders.frameFiles(f);
       inputs.push_back(framePath(dir, particles ? "particles" : "surface", f, "ply"));
-      inputs.push_back(dir / "scene.json");
+      inputs.push_back(settings);
       return isUpToDate({framePath(dir, "frames", f, "png")}, inputs);
     };
     frames.erase(std::remove_if(frames.begin(), frames.end(), done), frames.end());

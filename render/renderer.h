@@ -45,7 +45,9 @@ Image renderMeshWith(const TriangleMesh& water, const Scene& scene, int frame, c
 struct RenderOptions {
   std::string renderer;  // "embree" (path tracer), "gl" (OSMesa rasteriser), or empty: embree in 3D, gl in 2D
   bool particles = false;           // gl: draw particles/frame_NNNNN.ply as spheres instead of the surface
-  bool resume = false;  // leave a frame whose PNG is up to date (isUpToDate against its source and scene.json)
+  // Leave a frame whose PNG is up to date: isUpToDate against its source, its moving colliders' frame files and
+  // the render settings dir/render_settings.json (writeStageSettings), which the renderer's name is part of.
+  bool resume = false;
 };
 
 // For every frame in `range` writes dir/frames/frame_NNNNN.png: from dir/surface/frame_NNNNN.ply, or with the

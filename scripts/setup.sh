@@ -17,6 +17,7 @@ packages=(
   libopenvdb-dev libboost-iostreams-dev libopenvdb-tools
   libembree-dev libosmesa6-dev libstb-dev libtinyobjloader-dev
   libgtest-dev libbenchmark-dev ffmpeg gnuplot-nox zlib1g-dev libbullet-dev
+  slurm-wlm munge
 )
 
 missing=()
@@ -34,7 +35,9 @@ else
 fi
 
 jobs="$(nproc)"
-cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -Wno-dev >/dev/null
+# SURGE_ARCH=x86-64-v3 (say) builds for every node of a cluster from that CPU up instead of for this machine's
+# CPU (docs/cluster.md); empty keeps -march=native.
+cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSURGE_ARCH="${SURGE_ARCH:-}" -Wno-dev >/dev/null
 # The demo needs only the program; the tests need everything.
 if [ "$action" = demo ]; then target=(--target surge); else target=(); fi
 cmake --build "$build_dir" -j "$jobs" "${target[@]}"

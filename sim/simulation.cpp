@@ -1,6 +1,11 @@
 #include "sim/simulation.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -24,33 +29,40 @@ std::string formatVector(const Eigen::Vector3f& v, int dimensions) {
   return out.str();
 }
 
-// Rows of a per-frame table (stats.csv, colliders.csv) kept in memory and rewritten whole after every frame, so
-// the file is never half a row; on resume, the rows of the frames up to the one resumed from are kept.
+// A per-frame table (stats.csv, colliders.csv, bodies.csv). Opening it writes the header, and on resume the rows
+// of the frames up to the one resumed from, as a whole new file; each frame's rows are then appended by one
+// write, so that a run of 10^7 frames costs its rows once, not the file again at every frame. A row cut short
+// by a kill (no newline) is dropped on resume, as are the rows of frames after the one resumed from.
 class CsvFile {
  public:
-  CsvFile(fs::path path, std::string header, bool resume, int resumeFrame)
-      : path_(std::move(path)), header_(std::move(header)) {
-    if (!resume) return;
-    std::ifstream in(path_);
-    std::string line;
-    std::getline(in, line);  // header
-    while (std::getline(in, line)) {
-      const int frame = std::atoi(line.c_str());
-      if (!line.empty() && frame <= resumeFrame) rows_.push_back(line);
+  CsvFile(fs::path path, const std::string& header, bool resume, int resumeFrame) : path_(std::move(path)) {
+    std::string kept = header + "\n";
+    if (resume) {
+      std::error_code error;
+      const std::string text = fs::exists(path_, error) ? readTextFile(path_) : std::string();
+      size_t begin = text.find('\n');  // after the header
+      while (begin != std::string::npos && begin + 1 < text.size()) {
+        const size_t end = text.find('\n', begin + 1);
+        if (end == std::string::npos) break;  // the last row, cut short
+        const std::string line = text.substr(begin + 1, end - begin - 1);
+        if (!line.empty() && std::atoi(line.c_str()) <= resumeFrame) kept += line + "\n";
+        begin = end;
+      }
     }
+    writeFileAtomically(path_, [&](std::ostream& out) { out << kept; });
   }
   void add(const std::string& row) {
-    rows_.push_back(row);
-    writeFileAtomically(path_, [&](std::ostream& out) {
-      out << header_ << "\n";
-      for (const std::string& r : rows_) out << r << "\n";
-    });
+    const std::string line = row + "\n";
+    const int file = ::open(path_.c_str(), O_WRONLY | O_APPEND);
+    if (file < 0) throw RunError("cannot append to " + path_.string() + ": " + std::strerror(errno));
+    const ssize_t written = ::write(file, line.data(), line.size());
+    ::close(file);
+    if (written != ssize_t(line.size()))
+      throw RunError("cannot append to " + path_.string() + ": " + std::strerror(errno));
   }
 
  private:
   fs::path path_;
-  std::string header_;
-  std::vector<std::string> rows_;
 };
 
 // pressureMax is NaN for a solver without pressures (PBF) and written as an empty field.

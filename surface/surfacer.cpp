@@ -528,12 +528,15 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
     throw InputError(
         dir.string(), "--frames",
         "no particle frame in " + std::to_string(range.first) + ":" + std::to_string(range.last));
+  for (const char* ext : {"vdb", "ply", "obj"}) removeTemporaries(dir, "surface", ext, range);
+  // Written before any frame, so that every frame made with these settings is newer than it.
+  const fs::path settings = writeStageSettings(dir, "surface", scene);
   if (resume) {
     const auto done = [&](int f) {
       std::vector<fs::path> outputs = {framePath(dir, "surface", f, "vdb"),
                                        framePath(dir, "surface", f, "ply")};
       if (scene.surface.write_obj) outputs.push_back(framePath(dir, "surface", f, "obj"));
-      std::vector<fs::path> inputs = {framePath(dir, "particles", f, "ply"), dir / "scene.json"};
+      std::vector<fs::path> inputs = {framePath(dir, "particles", f, "ply"), settings};
       for (const fs::path& file : colliderFrameFiles(dir, scene, f)) inputs.push_back(file);
       return isUpToDate(outputs, inputs);
     };

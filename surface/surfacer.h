@@ -50,8 +50,8 @@ SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const 
 // dir/colliders/<name>.ply, a moving one's from dir/colliders/<name>/frame_NNNNN.ply when present. Reports
 // progress per frame ("surface") and checks for Ctrl-C between frames. Throws InputError naming dir if there
 // is no particle frame (in range), naming the file if a collider's mesh is missing or bad. With `resume`, a
-// frame whose files are up to date (isUpToDate against its particle frame, dir/scene.json and the frame files
-// of its moving colliders) is left as it is.
+// frame whose files are up to date (isUpToDate against its particle frame, the surface settings
+// dir/surface_settings.json (writeStageSettings) and the frame files of its moving colliders) is left as it is.
 void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress,
                    bool resume = false);
 

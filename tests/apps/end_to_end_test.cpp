@@ -18,17 +18,6 @@
 namespace surge {
 namespace {
 
-int countVideoFrames(const fs::path& mp4) {
-  const std::string command = "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
-                              "stream=nb_read_frames -of csv=p=0 '" + mp4.string() + "'";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return -1;
-  char buffer[64] = {0};
-  const bool read = std::fgets(buffer, sizeof buffer, pipe) != nullptr;
-  pclose(pipe);
-  return read ? std::atoi(buffer) : -1;
-}
-
 const char* kTinyScene = R"({
   "name": "tiny",
   "dimensions": 3,
@@ -135,7 +124,14 @@ TEST(EndToEnd, ResumedRunRedoesOnlyWhatIsMissingAndEndsOnTheSameBytes) {
   EXPECT_EQ(fs::last_write_time(png0), png0Time) << "frame 0 was up to date and should have been left";
   EXPECT_EQ(countVideoFrames(out / "tiny.mp4"), 4);
 
-  // A changed scene makes every frame stale: the render's size changes on every frame.
+  // A changed render setting makes every image stale, and nothing before it: the render's size changes on
+  // every frame, the surfaces and particles are left as they were.
+  auto times = [&](const std::string& sub, const std::string& ext) {
+    std::vector<fs::file_time_type> t;
+    for (int f = 0; f <= 3; ++f) t.push_back(fs::last_write_time(framePath(out, sub, f, ext)));
+    return t;
+  };
+  const auto surfaceTimes = times("surface", "ply"), particleTimes = times("particles", "ply");
   const SurgeResult wider = runSurge("run '" + scene.string() + "' --resume --set render.width=128 --out '" +
                                      out.string() + "' --quiet");
   ASSERT_EQ(wider.status, 0) << wider.err;
@@ -146,6 +142,20 @@ TEST(EndToEnd, ResumedRunRedoesOnlyWhatIsMissingAndEndsOnTheSameBytes) {
     EXPECT_EQ(width, 128) << "frame " << f;
     stbi_image_free(pixels);
   }
+  EXPECT_EQ(times("surface", "ply"), surfaceTimes) << "a render setting made the surfaces stale";
+  EXPECT_EQ(times("particles", "ply"), particleTimes);
+  // A changed surface setting makes the surfaces stale, and so the images made from them, not the particles.
+  const auto pngTimes = times("frames", "png");
+  const SurgeResult finer = runSurge("run '" + scene.string() +
+                                     "' --resume --set render.width=128 --set surface.voxel_size=0.012 --out '" +
+                                     out.string() + "' --quiet");
+  ASSERT_EQ(finer.status, 0) << finer.err;
+  const auto newSurfaceTimes = times("surface", "ply"), newPngTimes = times("frames", "png");
+  for (int f = 0; f <= 3; ++f) {
+    EXPECT_GT(newSurfaceTimes[f], surfaceTimes[f]) << "frame " << f;
+    EXPECT_GT(newPngTimes[f], pngTimes[f]) << "frame " << f;
+  }
+  EXPECT_EQ(times("particles", "ply"), particleTimes);
   fs::remove_all(out);
 }
 

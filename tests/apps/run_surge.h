@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -33,6 +34,18 @@ inline SurgeResult runSurge(const std::string& arguments) {
   result.out = readTextFile(dir / "out");
   result.err = readTextFile(dir / "err");
   return result;
+}
+
+// The frames ffprobe counts in a video, or -1.
+inline int countVideoFrames(const fs::path& mp4) {
+  const std::string command = "ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+                              "stream=nb_read_frames -of csv=p=0 '" + mp4.string() + "'";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return -1;
+  char buffer[64] = {0};
+  const bool read = std::fgets(buffer, sizeof buffer, pipe) != nullptr;
+  pclose(pipe);
+  return read ? std::atoi(buffer) : -1;
 }
 
 // Writes a scene file into the test's temporary folder.

@@ -36,7 +36,21 @@ TEST(Files, FrameNamesAndListing) {
   for (int f : {3, 0, 12}) writeFileAtomically(framePath(dir, "particles", f, "ply"), [](std::ostream&) {});
   writeFileAtomically(dir / "particles" / "frame_00004.ply.tmp123", [](std::ostream&) {});
   EXPECT_EQ(listFrames(dir, "particles", "ply"), (std::vector<int>{0, 3, 12}));
+  // Frames above 99,999 take six and seven digits (output.frames reaches 10^7); every stage lists them.
+  for (int f : {99999, 100000, 1234567}) writeFileAtomically(framePath(dir, "particles", f, "ply"), [](std::ostream&) {});
+  EXPECT_EQ(framePath(dir, "particles", 1234567, "ply").filename(), "frame_1234567.ply");
+  for (const char* odd : {"frame_0000012.ply", "frame_1234.ply", "frame_12345.plyx", "frame_1x345.ply"})
+    writeFileAtomically(dir / "particles" / odd, [](std::ostream&) {});
+  EXPECT_EQ(listFrames(dir, "particles", "ply"), (std::vector<int>{0, 3, 12, 99999, 100000, 1234567}));
   EXPECT_TRUE(listFrames(dir, "nothing", "ply").empty());
+  // A killed run's temporaries go, for the frames in the range only (another task may be writing the others).
+  writeFileAtomically(dir / "particles" / "frame_100000.ply.tmp77", [](std::ostream&) {});
+  removeTemporaries(dir, "particles", "ply", FrameRange::parse("5:99999"));
+  EXPECT_TRUE(fs::exists(dir / "particles" / "frame_00004.ply.tmp123"));
+  removeTemporaries(dir, "particles", "ply", FrameRange::parse("4:100000"));
+  EXPECT_FALSE(fs::exists(dir / "particles" / "frame_00004.ply.tmp123"));
+  EXPECT_FALSE(fs::exists(dir / "particles" / "frame_100000.ply.tmp77"));
+  EXPECT_TRUE(fs::exists(framePath(dir, "particles", 100000, "ply")));
 }
 
 TEST(Files, FrameRanges) {
