@@ -28,6 +28,7 @@ void submitRun(const Scene& scene, const fs::path& folder, const RunOptions& opt
   const std::vector<SlurmJob> jobs = runJobs(scene, options.scene, dir, options.common.overrides, options.renderer,
                                              "", options.slurm);
   if (!options.slurm.dryRun) {
+    sbatchProgram();
     checkOutputFolder(dir);
     if (!options.resume) {
       removeLaterStagesFrames(dir);

@@ -56,6 +56,13 @@ const char* kThreads = " --threads \"${SLURM_CPUS_PER_TASK:-0}\"";
 
 }  // namespace
 
+fs::path sbatchProgram() {
+  const fs::path sbatch = findProgram("sbatch");
+  if (sbatch.empty())
+    throw RunError("sbatch not found: --slurm needs Slurm's client commands (apt-get install slurm-client) on PATH");
+  return sbatch;
+}
+
 std::string shellQuote(const std::string& text) {
   std::string quoted = "'";
   for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
@@ -166,8 +173,7 @@ void submitJobs(const std::vector<SlurmJob>& jobs, const fs::path& dir, const Sl
     return;
   }
 
-  const fs::path sbatch = findProgram("sbatch");
-  if (sbatch.empty()) throw RunError("sbatch not found: --slurm needs Slurm's client commands on this machine");
+  const fs::path sbatch = sbatchProgram();
   fs::create_directories(folder / "logs");
   for (const SlurmJob& job : jobs)
     writeFileAtomically(folder / (job.name + ".sh"), [&](std::ostream& out) { out << job.script; });

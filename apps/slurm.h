@@ -56,6 +56,9 @@ std::vector<SlurmJob> studyJobs(const std::string& name, const fs::path& dir, in
 void submitJobs(const std::vector<SlurmJob>& jobs, const fs::path& dir, const SlurmOptions& options,
                 const CommonOptions& common);
 
+// sbatch's path; throws RunError when it is not on PATH. Asked before anything is written.
+fs::path sbatchProgram();
+
 // A word quoted for bash: 'text', with ' written as '\''.
 std::string shellQuote(const std::string& text);
 

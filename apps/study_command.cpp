@@ -214,6 +214,7 @@ void addStudyCommand(CLI::App& app) {
       for (const std::string& assignment : common.overrides) arguments.insert(arguments.end(), {"--set", assignment});
       arguments.push_back("--quiet");
       if (!options->slurm.dryRun) {
+        sbatchProgram();
         checkOutputFolder(absolute);
         writeFileAtomically(absolute / "scene.json", [&](std::ostream& out) { out << sceneToJson(scene); });
       }

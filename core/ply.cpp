@@ -115,6 +115,11 @@ PlyFile parsePly(const fs::path& path) {
     }
   }
   if (!sawFormat) fail("no format line");
+  // What is left after the header bounds every count below: no allocation larger than the file.
+  const std::streampos bodyStart = in.tellg();
+  in.seekg(0, std::ios::end);
+  const size_t bodySize = size_t(in.tellg() - bodyStart);
+  in.seekg(bodyStart);
   for (const PlyElement& element : file.elements) {
     std::string bytes;
     bool hasList = false;
@@ -124,6 +129,9 @@ PlyFile parsePly(const fs::path& path) {
       recordSize += typeSize(p.type);
     }
     if (!hasList) {
+      if (recordSize > 0 && element.count > bodySize / recordSize)
+        throw InputError(where, "element " + element.name,
+                         "file ends before its " + std::to_string(element.count) + " records");
       bytes.resize(recordSize * element.count);
       in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
       if (static_cast<size_t>(in.gcount()) != bytes.size())
@@ -140,7 +148,12 @@ PlyFile parsePly(const fs::path& path) {
             continue;
           }
           in.read(buffer, typeSize(p.countType));
-          const size_t items = static_cast<size_t>(readScalar(buffer, p.countType));
+          const double count = readScalar(buffer, p.countType);
+          // A list's length: a whole number the rest of the file can hold (PLY readers elsewhere trust it).
+          if (!in || !(count >= 0) || count != std::floor(count) || count * typeSize(p.type) > double(bodySize))
+            throw InputError(where, "element " + element.name,
+                             "record " + std::to_string(r) + " has a list length that is not a count the file holds");
+          const size_t items = static_cast<size_t>(count);
           bytes.append(buffer, typeSize(p.countType));
           std::string items_bytes(items * typeSize(p.type), '\0');
           in.read(items_bytes.data(), static_cast<std::streamsize>(items_bytes.size()));

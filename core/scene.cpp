@@ -20,7 +20,8 @@ namespace {
 using nlohmann::json;
 
 std::string describe(const json& value) {
-  std::string text = value.dump();
+  // A scene's strings need not be UTF-8: replaced, not thrown on, when quoted back in a message.
+  std::string text = value.dump(-1, ' ', false, json::error_handler_t::replace);
   if (text.size() > 40) text = text.substr(0, 37) + "...";
   return text;
 }
@@ -54,6 +55,12 @@ class JsonReader : public SceneVisitor {
       if (!j->is_string()) fail(key, "expected a string, got " + describe(*j));
       value = j->get<std::string>();
       if (info.required && value.empty()) fail(key, "must not be empty");
+      // scene.json is written back as JSON, which holds UTF-8 only (found by fuzz/fuzz_scene).
+      try {
+        (void)j->dump();
+      } catch (const json::type_error&) {
+        fail(key, "is not valid UTF-8 text");
+      }
     }
   }
 

@@ -17,7 +17,7 @@ packages=(
   libopenvdb-dev libboost-iostreams-dev libopenvdb-tools
   libembree-dev libosmesa6-dev libstb-dev libtinyobjloader-dev
   libgtest-dev libbenchmark-dev ffmpeg gnuplot-nox zlib1g-dev libbullet-dev
-  slurm-wlm munge
+  slurm-wlm munge clang libclang-rt-14-dev
 )
 
 missing=()
@@ -50,6 +50,12 @@ case "$action" in
     ;;
   test)
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" --timeout 900
+    # The fuzz regression (docs/reliability.md): the readers built again with clang, ASan, UBSan and libFuzzer
+    # in a folder of their own, and every committed corpus input run once.
+    CC=clang CXX=clang++ cmake -S . -B "$build_dir-fuzz" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSURGE_FUZZ=ON \
+      -DSURGE_BUILD_TESTS=OFF -DSURGE_BUILD_BENCHMARKS=OFF -DSURGE_ARCH="${SURGE_ARCH:-}" -Wno-dev >/dev/null
+    cmake --build "$build_dir-fuzz" -j "$jobs" --target surge_fuzzers
+    ctest --test-dir "$build_dir-fuzz" -L fuzz --output-on-failure -j "$jobs"
     ;;
   *) echo "usage: scripts/setup.sh [build|demo|test]" >&2; exit 2 ;;
 esac

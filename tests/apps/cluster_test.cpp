@@ -108,5 +108,40 @@ TEST(Cluster, SurfaceWaitFollowsARunningSimulation) {
   fs::remove_all(out);
 }
 
+// --slurm --dry-run prints every job's script with the options a cluster needs and the sbatch commands that
+// chain them, and writes nothing; without sbatch on PATH, --slurm stops before writing anything.
+TEST(Cluster, SlurmDryRunPrintsTheJobsAndWritesNothing) {
+  const fs::path scene = writeTestScene("small.json", kSmallScene);
+  const fs::path out = freshFolder("surge_cluster_dry");
+  const SurgeResult dry = runSurge("run '" + scene.string() + "' --slurm --dry-run --chunk 2 --partition gpu " +
+                                   "--account lab --time 1:00:00 --mem 4G --cpus-per-task 3 " +
+                                   "--sbatch=--qos=low --set output.frames=4 --out '" + out.string() + "'");
+  ASSERT_EQ(dry.status, 0) << dry.err;
+  EXPECT_FALSE(fs::exists(out)) << "a dry run wrote " << out;
+  for (const char* line : {"#SBATCH --partition=gpu", "#SBATCH --account=lab", "#SBATCH --time=1:00:00",
+                           "#SBATCH --mem=4G", "#SBATCH --cpus-per-task=3", "#SBATCH --qos=low", "#SBATCH --requeue",
+                           "#SBATCH --array=0-2", "--set 'output.frames=4'", "first=$(( SLURM_ARRAY_TASK_ID * 2 ))",
+                           "--dependency=afterok:<sim job id>", "--dependency=aftercorr:<surface job id>",
+                           "--dependency=afterok:<render job id>"})
+    EXPECT_NE(dry.out.find(line), std::string::npos) << "missing: " << line << "\n" << dry.out;
+  // Frames 0-4 in chunks of 2: three tasks, in each of the two arrays, and every script names the folder.
+  size_t arrays = 0;
+  for (size_t at = dry.out.find("#SBATCH --array=0-2"); at != std::string::npos;
+       at = dry.out.find("#SBATCH --array=0-2", at + 1))
+    ++arrays;
+  EXPECT_EQ(arrays, 2u);
+
+  const char* path = std::getenv("PATH");
+  const std::string saved = path ? path : "";
+  ::setenv("PATH", "/nonexistent", 1);
+  const SurgeResult missing = runSurge("run '" + scene.string() + "' --slurm --out '" + out.string() + "'");
+  ::setenv("PATH", saved.c_str(), 1);
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.err.find("sbatch not found"), std::string::npos) << missing.err;
+  EXPECT_FALSE(fs::exists(out));
+  // Slurm's options need --slurm.
+  EXPECT_EQ(runSurge("run '" + scene.string() + "' --chunk 3 --out '" + out.string() + "'").status, 2);
+}
+
 }  // namespace
 }  // namespace surge

@@ -108,5 +108,38 @@ TEST(Ply, BadFilesNameFileAndPlace) {
   }
 }
 
+// Counts the file cannot hold are refused before anything is allocated for them (found by fuzz/fuzz_mesh_ply:
+// a float list length of -9.5e8 was converted to an index, undefined behaviour).
+TEST(Ply, CountsTheFileCannotHoldAreRefused) {
+  const fs::path path = tempPath("counts.ply");
+  const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+                             "property float y\nproperty float z\nelement face 1\n";
+  const std::string vertices(36, '\0');
+  auto expectRefused = [&](const std::string& bytes, const std::string& words) {
+    { std::ofstream(path, std::ios::binary) << bytes; }
+    try {
+      readMeshPly(path);
+      ADD_FAILURE() << "accepted: " << words;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  const float negative = -9.5e8f, half = 2.5f;
+  std::string list(reinterpret_cast<const char*>(&negative), 4);
+  expectRefused(header + "property list float int vertex_indices\nend_header\n" + vertices + list,
+                "record 0 has a list length that is not a count the file holds");
+  list.assign(reinterpret_cast<const char*>(&half), 4);
+  expectRefused(header + "property list float int vertex_indices\nend_header\n" + vertices + list,
+                "record 0 has a list length");
+  const int huge = 1 << 30;
+  list.assign(reinterpret_cast<const char*>(&huge), 4);
+  expectRefused(header + "property list int int vertex_indices\nend_header\n" + vertices + list,
+                "record 0 has a list length");
+  // A trillion vertices claimed by a file of a hundred bytes: refused, not a bad_alloc.
+  expectRefused("ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\nproperty float x\n"
+                "end_header\n" + vertices,
+                "element vertex: file ends before its 1000000000000 records");
+}
+
 }  // namespace
 }  // namespace surge

@@ -107,6 +107,21 @@ TEST(Scene, OverridesApplyBeforeChecks) {
 TEST(Scene, EveryBadInputIsOneLineNamingFileAndKey) {
   EXPECT_NE(errorFor("/solver/typo", 1).find("solver.typo: unknown key"), std::string::npos);
   EXPECT_NE(errorFor("/extra", 1).find("extra: unknown key"), std::string::npos);
+  // Bytes that are not UTF-8 in a --set value (found by fuzz/fuzz_scene: the JSON library threw when the
+  // message quoted them, and would again when scene.json is written). The file's own JSON refuses them itself.
+  for (const char* assignment : {"solver.iterations=7+\xff\x8b", "name=ti\xff\xfeny"}) {
+    try {
+      parseScene(kValid, "scene.json", {assignment});
+      ADD_FAILURE() << "accepted " << assignment;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("--set: ", 0), 0u) << e.what();
+    }
+  }
+  try {
+    parseScene(kValid, "scene.json", {"name=ti\xff\xfeny"});
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("name: is not valid UTF-8 text"), std::string::npos) << e.what();
+  }
   EXPECT_NE(errorFor("/solver/substeps", "four").find("solver.substeps: expected an integer"), std::string::npos);
   EXPECT_NE(errorFor("/solver/substeps", 2.5).find("solver.substeps: expected an integer"), std::string::npos);
   EXPECT_NE(errorFor("/particle_spacing", nullptr, true).find("particle_spacing: missing required key"),
