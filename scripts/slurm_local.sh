@@ -55,7 +55,7 @@ PartitionName=debug Nodes=localhost Default=YES MaxTime=INFINITE State=UP
 EOF
   export SLURM_CONF="$dir/slurm.conf"
   slurmctld -f "$SLURM_CONF" || return 1
-  slurmd -f "$SLURM_CONF" || return 1
+  slurmd -N localhost -f "$SLURM_CONF" || return 1  # the node by name, not by resolving the machine's
   local i
   for i in $(seq 1 100); do
     if sinfo -h -o '%t' 2>/dev/null | grep -q '^idle'; then return 0; fi
