@@ -40,6 +40,7 @@ if [ "$action" = sanitize ]; then
   # Uninstrumented libraries (OpenVDB, TBB, Embree) share std::vector with ours: their container annotations
   # would not match, so ASan's container-overflow check is off; overflows, use after free, leaks and UB are on.
   export ASAN_OPTIONS="detect_container_overflow=0:detect_leaks=1" UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+  export LSAN_OPTIONS="suppressions=$here/tests/lsan_suppressions.txt"
   cmake -S . -B "$build_dir-sanitize" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSURGE_SANITIZE=ON \
     -DSURGE_BUILD_BENCHMARKS=OFF -DSURGE_ARCH="${SURGE_ARCH:-}" -Wno-dev >/dev/null
   cmake --build "$build_dir-sanitize" -j "$jobs"
