@@ -1,7 +1,6 @@
 #include "apps/slurm.h"
 
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include "core/errors.h"
@@ -184,11 +183,7 @@ void submitJobs(const std::vector<SlurmJob>& jobs, const fs::path& dir, const Sl
     std::string id = result.output.substr(0, result.output.find_first_of(";\n"));
     if (result.exitCode != 0 || id.empty()) {
       // Leave nothing half-submitted: the jobs that would wait for this one forever go too.
-      if (!ids.empty()) {
-        std::vector<std::string> cancel = ids;
-        const fs::path scancel = findProgram("scancel");
-        if (!scancel.empty()) runProgram(scancel, cancel);
-      }
+      if (const fs::path scancel = findProgram("scancel"); !ids.empty() && !scancel.empty()) runProgram(scancel, ids);
       std::string why = result.errors;
       while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) why.pop_back();
       for (char& c : why)

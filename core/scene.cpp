@@ -652,14 +652,14 @@ std::string sceneToJson(const Scene& scene) {
 
 fs::path writeStageSettings(const fs::path& dir, const std::string& stage, const Scene& scene,
                             const std::string& extra) {
-  std::vector<const char*> keys = {"dimensions", "domain", "particle_spacing", "colliders", "bodies"};
-  if (stage == "surface" || stage == "render") keys.push_back(stage.c_str());
-  else throw std::logic_error("writeStageSettings: no stage '" + stage + "'");
+  if (stage != "surface" && stage != "render") throw std::logic_error("writeStageSettings: no stage '" + stage + "'");
+  // The keys both stages read, and the stage's own section.
+  const std::vector<std::string> keys = {"dimensions", "domain", "particle_spacing", "colliders", "bodies", stage};
   Scene copy = scene;
   JsonWriter writer(copy);
   visitScene(copy, writer);
   json settings = json::object();
-  for (const char* key : keys)
+  for (const std::string& key : keys)
     if (writer.root().contains(key)) settings[key] = writer.root()[key];
   settings["options"] = json::parse(extra);
   const std::string text = settings.dump(2) + "\n";
