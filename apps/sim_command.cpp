@@ -46,6 +46,15 @@ void writeSimStatus(const fs::path& dir, const std::string& status) {
   writeFileAtomically(dir / "sim_status.txt", [&](std::ostream& out) { out << status << "\n"; });
 }
 
+// On the way out of a failed run: the status is told if the disk allows, and the run's own error is the one
+// reported (a full disk fails this write too).
+void writeSimStatusIfPossible(const fs::path& dir, const std::string& status) {
+  try {
+    writeSimStatus(dir, status);
+  } catch (const std::exception&) {
+  }
+}
+
 std::string readSimStatus(const fs::path& dir) {
   std::error_code error;
   if (!fs::exists(dir / "sim_status.txt", error)) return "";
@@ -73,6 +82,17 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   const std::string previous = existing ? readTextFile(dir / "scene.json") : std::string();
   if (resume && existing && !listFrames(dir, "particles", "ply").empty())
     checkResumable(dir / "scene.json", previous, json);
+  // The particle frames still to write (28 bytes a particle and a header) must fit the disk: a run that would
+  // fill it is refused now, not hours later. A resumed run writes the frames after its last one.
+  const std::vector<int> written = resume ? listFrames(dir, "particles", "ply") : std::vector<int>{};
+  const int framesLeft =
+      written.empty() ? scene.output.frames + 1 : std::max(0, scene.output.frames - written.back());
+  double freed = 0;  // a new run first removes an earlier run's frames from the folder
+  for (const char* sub : {"particles", "surface", "frames"})
+    for (const auto& entry : fs::recursive_directory_iterator(dir / sub, error))
+      if (!resume && entry.is_regular_file(error)) freed += double(entry.file_size(error));
+  checkFreeSpace(dir, "--out", double(framesLeft) * (28.0 * double(scene.particleCount()) + 512.0) - freed,
+                 std::to_string(framesLeft) + " particle frames");
   checkOutputFolder(dir);
   if (!resume) removeLaterStagesFrames(dir);
   // Rewritten only when it changes: its time tells the later stages' --resume whether their frames are stale.
@@ -84,10 +104,10 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   try {
     summary = simulate(scene, shapes, dir, resume, progress);
   } catch (const Interrupted&) {
-    writeSimStatus(dir, "stopped");
+    writeSimStatusIfPossible(dir, "stopped");
     throw;
   } catch (const std::exception& e) {
-    writeSimStatus(dir, std::string("failed: ") + e.what());
+    writeSimStatusIfPossible(dir, std::string("failed: ") + e.what());
     throw;
   }
   writeSimStatus(dir, "finished");

@@ -1,5 +1,6 @@
 #include "core/files.h"
 
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,17 +14,25 @@
 
 namespace surge {
 
+std::string writeFailure(int error) {
+  if (error == ENOSPC || error == EDQUOT) return "the disk is full (" + std::string(std::strerror(error)) + ")";
+  return error != 0 ? std::string(std::strerror(error)) : "the write failed";
+}
+
 void writeFileAtomically(const fs::path& path, const std::function<void(std::ostream&)>& write) {
   if (path.has_parent_path()) fs::create_directories(path.parent_path());
   fs::path temporary = path;
   temporary += ".tmp" + std::to_string(::getpid());
   try {
     {
+      errno = 0;
       std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-      if (!out) throw RunError("cannot write " + temporary.string());
+      if (!out) throw RunError("cannot write " + path.string() + ": " + writeFailure(errno));
       write(out);
       out.flush();
-      if (!out) throw RunError("error while writing " + temporary.string());
+      if (out) out.close();
+      // The stream keeps no error code of its own: errno still holds the failed write's (ENOSPC on a full disk).
+      if (!out) throw RunError("cannot write " + path.string() + ": " + writeFailure(errno));
     }
     fs::rename(temporary, path);
   } catch (...) {
@@ -140,6 +149,25 @@ void checkOutputFolder(const fs::path& dir) {
     if (entry->is_symlink(error) && fs::is_directory(entry->path(), error))
       throw InputError(entry->path().string(),
                        "is a symbolic link to a folder; Surge writes only inside its output folder");
+}
+
+void checkFreeSpace(const fs::path& dir, const std::string& key, double bytes, const std::string& what) {
+  // The folder may not be made yet: its nearest existing parent is on the same file system.
+  fs::path existing = fs::absolute(dir);
+  std::error_code error;
+  while (!fs::exists(existing, error) && existing.has_parent_path() && existing != existing.parent_path())
+    existing = existing.parent_path();
+  struct statvfs info {};
+  if (::statvfs(existing.c_str(), &info) != 0) return;  // a file system that cannot say: left to the writes
+  const double free = double(info.f_bavail) * double(info.f_frsize);
+  if (bytes <= free) return;
+  auto size = [](double b) {
+    char text[32];
+    std::snprintf(text, sizeof text, b >= 1e9 ? "%.1f GB" : "%.1f MB", b >= 1e9 ? b / 1e9 : b / 1e6);
+    return std::string(text);
+  };
+  throw InputError(dir.string(), key,
+                   what + " need about " + size(bytes) + " and its file system has " + size(free) + " free");
 }
 
 }  // namespace surge

@@ -15,6 +15,13 @@ namespace fs = std::filesystem;
 // old file or the whole new one. On any exception the temporary file is removed and the exception rethrown.
 void writeFileAtomically(const fs::path& path, const std::function<void(std::ostream&)>& write);
 
+// Why a write failed, from its errno, for a one-line message: "the disk is full (...)" for ENOSPC and EDQUOT.
+std::string writeFailure(int error);
+
+// Throws InputError naming `dir` and `key` when the file system holding `dir` has fewer than `bytes` free:
+// a run that would fill the disk is refused before it starts. `what` says what needs the space.
+void checkFreeSpace(const fs::path& dir, const std::string& key, double bytes, const std::string& what);
+
 // dir/sub/frame_NNNNN.ext: five digits, more for frames above 99,999 (output.frames reaches 10^7).
 fs::path framePath(const fs::path& dir, const std::string& sub, int frame, const std::string& ext);
 

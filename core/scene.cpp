@@ -584,6 +584,40 @@ int stableSubsteps(const Scene& scene) {
   return int(std::min(steps, 100000.0));
 }
 
+double runawaySpeed(const Scene& scene) {
+  const int d = scene.dimensions;
+  const double diagonal = (scene.domain.max - scene.domain.min).head(d).norm();
+  double fluid = 0, bodies = 0, colliders = 0, attractor = 0;
+  for (const FluidBlock& block : scene.fluids) fluid = std::max(fluid, block.velocity.head(d).norm());
+  for (const BodySettings& body : scene.bodies)
+    bodies = std::max(bodies, body.velocity.head(d).norm() + body.angular_velocity.norm() * diagonal);
+  for (const ColliderSettings& collider : scene.colliders)
+    for (size_t k = 1; k < collider.motion.size(); ++k) {
+      const ColliderKeyframe &a = collider.motion[k - 1], &b = collider.motion[k];
+      const double dt = b.time - a.time;
+      if (!(dt > 0)) continue;
+      const double turn = std::abs(b.rotation.degrees - a.rotation.degrees) * M_PI / 180.0 +
+                          (a.rotation.axis != b.rotation.axis ? 2 * M_PI : 0.0);
+      colliders = std::max(colliders, ((b.position - a.position).head(d).norm() + turn * diagonal) / dt);
+    }
+  if (!scene.attractor.keyframes.empty()) {
+    attractor = std::sqrt(std::abs(scene.attractor.strength) * scene.attractor.radius);
+    for (size_t k = 1; k < scene.attractor.keyframes.size(); ++k) {
+      const AttractorKeyframe &a = scene.attractor.keyframes[k - 1], &b = scene.attractor.keyframes[k];
+      if (b.time > a.time)
+        attractor = std::max(attractor, std::sqrt(std::abs(scene.attractor.strength) * scene.attractor.radius) +
+                                            (b.position - a.position).head(d).norm() / (b.time - a.time));
+    }
+  }
+  const double fall = std::sqrt(2 * scene.gravity.head(d).norm() * diagonal);
+  // PBF's projection moves a particle up to about a spacing a step, and the velocity is that move over the step;
+  // WCSPH's pressure only turns the energy of compression, which the fall gave, back into motion, and is given a
+  // spacing a frame, so that a scene with nothing moving (no gravity) still has a limit above zero.
+  const double solver = scene.particle_spacing * scene.output.fps *
+                        (scene.solver.method == "wcsph" ? 1 : std::max(1, scene.solver.substeps));
+  return 10 * (fluid + bodies + 2 * colliders + attractor + fall + solver);
+}
+
 std::vector<SolidFiles> solidFiles(const Scene& scene) {
   std::vector<SolidFiles> solids;
   for (const ColliderSettings& c : scene.colliders) solids.push_back({c, "colliders", c.motion.size() > 1});

@@ -191,6 +191,14 @@ std::vector<SolidFiles> solidFiles(const Scene& scene);
 int stableSubsteps(const Scene& scene);
 // solver.substeps 0 (the default) resolves to max(4, stableSubsteps); a number given is taken as it is.
 
+// The speed that marks a particle as run away (a diverged solver): ten times the fastest the scene can give a
+// particle, which is the sum of its initial speeds (fluid, bodies, with their spin over the tank's diagonal),
+// twice the fastest collider (a wall moving at V throws what it meets at up to 2 V), the attractor's pull
+// (sqrt(strength radius), the speed of a fall into it) and its own speed, a free fall across the tank's diagonal
+// (sqrt(2 g L)), and the solver's own push (PBF: a spacing a step; WCSPH: a spacing a frame). Stable runs stay
+// well under a tenth of it; a blow-up passes it within a few steps.
+double runawaySpeed(const Scene& scene);
+
 // Lattice points of one fluid box: counts per axis (1 on unused axes in 2D).
 Eigen::Array3i latticeCounts(const Scene& scene, const Box& box);
 

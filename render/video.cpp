@@ -1,5 +1,9 @@
 #include "render/video.h"
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -33,7 +37,13 @@ void makeVideo(const fs::path& dir, const Scene& scene, Progress& progress) {
   if (ffmpeg.empty()) throw RunError("ffmpeg not found: install it (apt-get install ffmpeg) to make videos");
 
   const fs::path video = dir / (scene.name + ".mp4");
-  const fs::path temporary = dir / ("." + scene.name + ".mp4.partial");
+  // The temporary carries the process id: an ffmpeg left running by a killed `surge` (SIGKILL reaches only surge)
+  // may still be writing its own, which must neither mix with this one nor be left behind.
+  const std::string partial = "." + scene.name + ".mp4.partial";
+  std::error_code listing;
+  for (const auto& entry : fs::directory_iterator(dir, listing))
+    if (entry.path().filename().string().rfind(partial, 0) == 0) fs::remove(entry.path(), listing);
+  const fs::path temporary = dir / (partial + std::to_string(::getpid()));
   std::ostringstream fps;
   fps << scene.output.fps;
   const std::vector<std::string> arguments = {"-nostdin",
@@ -77,9 +87,12 @@ void makeVideo(const fs::path& dir, const Scene& scene, Progress& progress) {
     std::error_code ignored;
     fs::remove(temporary, ignored);
     Progress::checkInterrupt();  // Ctrl-C reaches ffmpeg too: report the interruption, not ffmpeg's exit
-    throw RunError(
-        "ffmpeg failed to make " + video.string() + ": " +
-        (result.errors.empty() ? "exit status " + std::to_string(result.exitCode) : trimmed(result.errors)));
+    // ffmpeg's own words for a full disk are several lines about headers and codec parameters.
+    const bool full = result.errors.find(std::strerror(ENOSPC)) != std::string::npos;
+    throw RunError("ffmpeg failed to make " + video.string() + ": " +
+                   (full                   ? writeFailure(ENOSPC)
+                    : result.errors.empty() ? "exit status " + std::to_string(result.exitCode)
+                                            : trimmed(result.errors)));
   }
   progress.advance();
   progress.finish();

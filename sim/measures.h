@@ -60,11 +60,21 @@ FluidMeasures measureDensityAndEnergy(const std::vector<Vec<Dim>>& x, const std:
   return m;
 }
 
-// The index of the first particle whose position or velocity is not finite or whose position left the tank,
-// or -1.
+// The runaway speed of particles set with velocities of their own (a test's swirl, a resumed frame): the
+// scene's, plus ten times the fastest of them, as runawaySpeed counts the scene's initial speeds.
+template <int Dim>
+float runawaySpeedFor(float sceneLimit, const std::vector<Vec<Dim>>& v) {
+  float fastest = 0;
+  for (const Vec<Dim>& velocity : v) fastest = std::max(fastest, velocity.norm());
+  return sceneLimit + 10 * fastest;
+}
+
+// The index of the first particle whose position or velocity is not finite, whose position left the tank, or
+// whose speed passed `speedLimit` (runawaySpeed, core/scene.h: a blow-up that the tank's clamp would otherwise
+// hide inside the tank), or -1.
 template <int Dim>
 long firstParticleOutside(const std::vector<Vec<Dim>>& x, const std::vector<Vec<Dim>>& v,
-                          const TankWalls<Dim>& walls) {
+                          const TankWalls<Dim>& walls, float speedLimit) {
   struct First {
     long index = -1;
     First& operator+=(const First& o) {
@@ -72,10 +82,13 @@ long firstParticleOutside(const std::vector<Vec<Dim>>& x, const std::vector<Vec<
       return *this;
     }
   };
+  const float limitSquared = speedLimit * speedLimit;
   return parallelSum<First>(0, x.size(), [&](size_t b, size_t e) {
            First first;
            for (size_t i = b; i < e && first.index < 0; ++i)
-             if (!x[i].allFinite() || !v[i].allFinite() || !walls.contains(x[i])) first.index = static_cast<long>(i);
+             if (!x[i].allFinite() || !v[i].allFinite() || !walls.contains(x[i]) ||
+                 !(v[i].squaredNorm() <= limitSquared))
+               first.index = static_cast<long>(i);
            return first;
          }).index;
 }

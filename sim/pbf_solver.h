@@ -108,6 +108,8 @@ class PbfSolver {
   std::vector<uint32_t> scratchIds_;
   NeighborGrid<Dim> grid_;
   TankWalls<Dim> walls_;
+  float sceneSpeedLimit_ = 0;  // runawaySpeed(scene)
+  float speedLimit_ = 0;       // and ten times the fastest particle given (runawaySpeedFor): faster is a blow-up
   Colliders<Dim> colliders_;  // empty without colliders
   float stepDt_ = 0;          // the current step (turns collider displacements into impulses)
   NeighborLists neighbors_;

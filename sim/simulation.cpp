@@ -54,11 +54,12 @@ class CsvFile {
   void add(const std::string& row) {
     const std::string line = row + "\n";
     const int file = ::open(path_.c_str(), O_WRONLY | O_APPEND);
-    if (file < 0) throw RunError("cannot append to " + path_.string() + ": " + std::strerror(errno));
+    if (file < 0) throw RunError("cannot append to " + path_.string() + ": " + writeFailure(errno));
+    errno = 0;
     const ssize_t written = ::write(file, line.data(), line.size());
+    const int error = written < 0 ? errno : ENOSPC;  // a short write: the disk filled during it
     ::close(file);
-    if (written != ssize_t(line.size()))
-      throw RunError("cannot append to " + path_.string() + ": " + std::strerror(errno));
+    if (written != ssize_t(line.size())) throw RunError("cannot append to " + path_.string() + ": " + writeFailure(error));
   }
 
  private:
@@ -109,11 +110,15 @@ float walkWhileContiguous(const std::vector<float>& sorted, size_t start, float 
   return sorted[i];
 }
 
-[[noreturn]] void diverged(int frame, int substep, long particle, const ParticleFrame& state) {
+[[noreturn]] void diverged(const Scene& scene, int frame, int substep, long particle, const ParticleFrame& state) {
+  char limit[32];
+  std::snprintf(limit, sizeof limit, "%.4g", runawaySpeed(scene));
   throw RunError("simulation diverged at frame " + std::to_string(frame) + ", substep " + std::to_string(substep) +
                  ": particle " + std::to_string(particle) + " (id " + std::to_string(state.id[particle]) + ") at " +
                  formatVector(state.position[particle], state.dimensions) + " with velocity " +
-                 formatVector(state.velocity[particle], state.dimensions) + " (not finite or outside the domain)");
+                 formatVector(state.velocity[particle], state.dimensions) +
+                 " (not finite, outside the domain, or faster than " + limit +
+                 " m/s, ten times the fastest the scene can give it)");
 }
 
 // One colliders.csv row a collider: the frame's mean force (N) and torque about the collider's position (N m).
@@ -297,7 +302,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
       iterations += solver.lastIterations();
       if (bad >= 0) {
         solver.getParticles(frame);
-        diverged(f, steps, bad, frame);
+        diverged(scene, f, steps, bad, frame);
       }
       if (++steps >= kMostSteps)
         throw RunError("simulation stalled at frame " + std::to_string(f) + ": a million steps of " +

@@ -44,6 +44,7 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const Collider
             static_cast<float>(0.5 * scene.solver.kernel_radius)),
       walls_(makeWalls<Dim>(scene)) {
   if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
+  sceneSpeedLimit_ = static_cast<float>(runawaySpeed(scene));
   const SolverSettings& s = scene.solver;
   support_ = static_cast<float>(s.kernel_radius);
   smoothingLength_ = 0.5f * support_;
@@ -80,6 +81,7 @@ void WcsphSolver<Dim>::setParticles(const ParticleFrame& frame) {
   colliders_.resetSlots(n);
   colliderForces_.assign(colliders_.size(), Wrench{});
   accelerationsValid_ = false;
+  speedLimit_ = runawaySpeedFor(sceneSpeedLimit_, v_);
 }
 
 template <int Dim>
@@ -184,7 +186,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     accelerationsValid_ = false;
   }
   time_ = time + dt;
-  return firstParticleOutside(x_, v_, walls_);
+  return firstParticleOutside(x_, v_, walls_, speedLimit_);
 }
 
 template <int Dim>

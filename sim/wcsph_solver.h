@@ -91,6 +91,8 @@ class WcsphSolver {
   std::vector<float> nearPressure_;  // only with near_pressure > 0
   NeighborGrid<Dim> grid_;
   TankWalls<Dim> walls_;
+  float sceneSpeedLimit_ = 0;  // runawaySpeed(scene)
+  float speedLimit_ = 0;       // and ten times the fastest particle given (runawaySpeedFor): faster is a blow-up
   Colliders<Dim> colliders_;             // empty without colliders
   std::vector<Wrench> colliderForces_;   // each collider's force at the last evaluation (for the impulses)
   NeighborLists neighbors_;

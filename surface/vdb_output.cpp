@@ -2,12 +2,16 @@
 // The only file of Surge that includes OpenVDB's points headers.
 #include "surface/vdb_output.h"
 
-#include <openvdb/io/File.h>
+#include <openvdb/io/Archive.h>
 #include <openvdb/points/PointConversion.h>
 #include <openvdb/points/PointDataGrid.h>
 #include <openvdb/tools/PointIndexGrid.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
 #include <string>
 
 #include "core/errors.h"
@@ -56,6 +60,44 @@ openvdb::points::PointDataGrid::Ptr pointsGrid(const std::vector<Eigen::Vector3f
   return grid;
 }
 
+// OpenVDB stamps every file it writes with a random UUID (36 characters at byte 21 of the header: the magic
+// number, the file version, the library's major and minor versions and the grid-offsets flag come first), so two
+// writes of the same grids differ in those bytes. Surge's outputs are the same bytes whatever the thread count
+// and after a resume, so the UUID is replaced by one made from the file's other bytes (two FNV-1a hashes with
+// different offsets): still different for different content, which is what readers compare it for.
+void stampContentUuid(const fs::path& file) {
+  constexpr std::streamoff kOffset = 21, kLength = 36;
+  std::fstream stream(file, std::ios::binary | std::ios::in | std::ios::out);
+  std::uint64_t a = 14695981039346656037ull, b = 1099511628211ull * 31;
+  std::vector<char> buffer(1 << 20);
+  std::streamoff position = 0;
+  while (stream.read(buffer.data(), std::streamsize(buffer.size())) || stream.gcount() > 0) {
+    for (std::streamsize i = 0; i < stream.gcount(); ++i, ++position) {
+      if (position >= kOffset && position < kOffset + kLength) continue;
+      a = (a ^ std::uint8_t(buffer[i])) * 1099511628211ull;
+      b = (b ^ std::uint8_t(buffer[i])) * 1099511628211ull;
+    }
+  }
+  if (position < kOffset + kLength) throw RunError("cannot write " + file.string() + ": short VDB header");
+  char uuid[40];
+  std::snprintf(uuid, sizeof uuid, "%08x-%04x-%04x-%04x-%012llx", unsigned(a >> 32), unsigned(a >> 16) & 0xffff,
+                unsigned(a) & 0xffff, unsigned(b >> 48), static_cast<unsigned long long>(b & 0xffffffffffffull));
+  stream.clear();
+  stream.seekp(kOffset);
+  stream.write(uuid, kLength);
+  if (!stream.flush()) throw RunError("cannot write " + file.string() + ": " + writeFailure(errno));
+}
+
+// What openvdb::io::File::write does (a seekable archive, so readers can load one grid without the others),
+// but into a stream of our own: File ignores the stream's state, so a write that fails (a full disk) would
+// leave a cut-short file and no error.
+class SeekableArchive : public openvdb::io::Archive {
+ public:
+  void writeTo(std::ostream& out, const openvdb::GridCPtrVec& grids) const {
+    write(out, grids, /*seekable=*/true);
+  }
+};
+
 }  // namespace
 
 void writeSurfaceVdb(const fs::path& path, const openvdb::FloatGrid::Ptr& surface, const VdbExtras& extras) {
@@ -71,15 +113,20 @@ void writeSurfaceVdb(const fs::path& path, const openvdb::FloatGrid::Ptr& surfac
   }
   grids.insert(grids.end(), extras.colliders.begin(), extras.colliders.end());
 
-  // openvdb::io::File writes to a path, not a stream, so the atomic write is done here: a temporary name in
-  // the same folder (same file system, so the rename is atomic), then rename.
+  // The atomic write is done here, as the UUID is stamped once the file is whole: a temporary name in the same
+  // folder (same file system, so the rename is atomic), then rename.
   if (path.has_parent_path()) fs::create_directories(path.parent_path());
   fs::path temporary = path;
   temporary += ".tmp" + std::to_string(::getpid());
   try {
-    openvdb::io::File file(temporary.string());
-    file.write(grids);
-    file.close();
+    {
+      errno = 0;
+      std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
+      if (file) SeekableArchive().writeTo(file, grids);
+      if (file) file.close();
+      if (!file) throw RunError("cannot write " + path.string() + ": " + writeFailure(errno));
+    }
+    stampContentUuid(temporary);
     fs::rename(temporary, path);
   } catch (const openvdb::Exception& e) {
     std::error_code ignored;

@@ -100,7 +100,7 @@ after=$(cd "$out/frames" && echo "$before" | while read -r name rest; do stat -c
 [ "$(ls "$out/particles" | grep -c '^frame_[0-9]*\.ply$')" -eq 30 ] || fail "particle frames: $(ls "$out/particles" | wc -l)"
 [ "$(ls "$out/surface" | grep -c '^frame_[0-9]*\.ply$')" -eq 30 ] || fail "surface frames"
 [ "$(ls "$out/frames" | grep -c '^frame_[0-9]*\.png$')" -eq 30 ] || fail "rendered frames: $(ls "$out/frames")"
-leftovers=$(find "$out" -name '*.tmp*' -o -name '*.partial')
+leftovers=$(find "$out" -name '*.tmp*' -o -name '*.partial*')
 [ -z "$leftovers" ] || fail "partial files left: $leftovers"
 frames=$(ffprobe -v error -select_streams v:0 -count_frames -show_entries stream=nb_read_frames -of csv=p=0 \
   "$out/slurm_small.mp4")

@@ -181,6 +181,62 @@ TEST(Surfacer, RestingBlockEnclosesItsFluidVolumeAndIsClosed) {
   expectUnitNormals(mesh);
 }
 
+// A shape the surfacers' constants were not calibrated on (they were set on the axis-aligned block above): a slab
+// of 24 x 24 x 6 lattice points whose lattice is turned 30 degrees about z and then 20 about x, so that its faces
+// cross the voxel grid at a slant and its layers are not voxel planes.
+TEST(Surfacer, SlantedSlabEnclosesItsVolumeWithFlatFacesAtTheFluidsFace) {
+  const double h = 0.02;
+  const Eigen::Matrix3d turn = (Eigen::AngleAxisd(20 * kPi / 180, Eigen::Vector3d::UnitX()) *
+                                Eigen::AngleAxisd(30 * kPi / 180, Eigen::Vector3d::UnitZ()))
+                                   .toRotationMatrix();
+  const Eigen::Vector3d centre(0.0137, 0.2, -0.31);
+  const int n[3] = {24, 24, 6};  // the slab's thin axis is the lattice's z
+  ParticleFrame frame;
+  for (int i = 0; i < n[0]; ++i)
+    for (int j = 0; j < n[1]; ++j)
+      for (int k = 0; k < n[2]; ++k) {
+        const Eigen::Vector3d local = h * Eigen::Vector3d(i - (n[0] - 1) / 2.0, j - (n[1] - 1) / 2.0, k - (n[2] - 1) / 2.0);
+        add(frame, (centre + turn * local).cast<float>());
+      }
+  const double fluid = double(frame.size()) * h * h * h, halfThickness = 3 * h;
+  // `anisotropic` is left out: on this slab it makes an open mesh (96 unpaired edges) with a lump up to 6
+  // spacings above the top face near one edge, a fault this test found and docs/reliability.md leaves open.
+  for (const char* method : {"spheres", "smooth_spheres"}) {
+    SCOPED_TRACE(method);
+    const TriangleMesh mesh = meshParticles(frame, sceneWithSpacing(h, 3, method));
+    expectClosedAndOriented(mesh);
+    const double volume = signedVolume(mesh);
+    // The faces: vertices over the slab's middle (3 spacings or more in from its edges) sit on its two faces,
+    // 3 spacings either side of the mid-plane.
+    double offsetSum = 0, worst = 0;
+    size_t faceVertices = 0;
+    for (const auto& x : mesh.positions) {
+      const Eigen::Vector3d local = turn.transpose() * (x.cast<double>() - centre);
+      if (std::abs(local.x()) > 9 * h || std::abs(local.y()) > 9 * h) continue;
+      const double offset = std::abs(local.z()) - halfThickness;
+      offsetSum += offset;
+      worst = std::max(worst, std::abs(offset));
+      ++faceVertices;
+    }
+    const double meanOffset = offsetSum / double(faceVertices);
+    std::printf("slanted slab (%s): N=%zu volume error %.2f%%, %zu face vertices %.4f spacings off the face on "
+                "average, %.3f at worst\n",
+                method, frame.size(), 100 * (volume / fluid - 1), faceVertices, meanOffset / h, worst / h);
+    ASSERT_GT(faceVertices, 100u);
+    // The faces where the fluid's are, to a quarter of a voxel (an eighth of a spacing) on average: the block's
+    // calibration holds to 0.006 spacings on voxel-aligned faces; a slanted face also samples the lattice's
+    // layers at every phase against the voxels, which the smoothing averages but does not remove.
+    EXPECT_NEAR(meanOffset, 0.0, 0.125 * h);
+    // Flat: no face vertex a voxel (half a spacing) off the face, the height of a lattice staircase step.
+    EXPECT_LT(worst, 0.5 * h);
+    // The volume: the faces' allowance over their 1,728 h^2 of area is 216 h^3 (6.3% of the 3,456 h^3), and the
+    // 216 h of edges rounded to about 1.3 h take (1 - pi/4) 1.69 h^2 each unit of length, 79 h^3 (2.3%). So the
+    // mesh holds between 91% and 100% of the fluid's volume, plus the faces' allowance outward.
+    EXPECT_GT(volume / fluid, 1 - 0.063 - 0.023);
+    EXPECT_LT(volume / fluid, 1 + 0.063);
+  }
+}
+
 TEST(Surfacer, BandAcrossABlocksFaceIsASignedDistanceToTheFluidsFace) {
   // Down columns through the top face of the block (16 of them, away from the edges), the level set at 1, 0.5
   // spacings above the fluid's face, on it, and 0.5, 1, 1.5 below: the distance to that face. Tolerance 0.05
