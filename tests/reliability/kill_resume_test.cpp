@@ -56,10 +56,12 @@ TEST(KillAndResume, EveryStageKilledAtRandomPointsResumesToTheSameBytes) {
       const fs::path dir = freshFolder("kill_" + std::to_string(stage) + "_" + std::to_string(point));
       bool landed = false;
       double delay = 0, drawn = window;
+      pid_t run = 0;
       for (int attempt = 0; attempt < 7 && !landed; ++attempt, drawn *= 0.5) {
+        if (run > 0) killGroupAndRemove(run, dir);  // a kill that missed may have orphaned ffmpeg
         fs::remove_all(dir);
         delay = std::uniform_real_distribution<double>(0, 0.9 * drawn)(random);
-        const pid_t run = startRun(scene, dir, false);
+        run = startRun(scene, dir, false);
         // Wait for the stage to start (or the run to end), then for the drawn delay.
         bool ended = false;
         while (!markerExists(dir, stage) && !(ended = ::waitpid(run, &status, WNOHANG) == run))
@@ -97,7 +99,7 @@ TEST(KillAndResume, EveryStageKilledAtRandomPointsResumesToTheSameBytes) {
       expectSameFiles(folderContents(dir), expected,
                       std::string("after a kill in ") + kStages[stage] + " at " + std::to_string(delay) +
                           " s and --resume");
-      fs::remove_all(dir);
+      killGroupAndRemove(run, dir);
     }
   }
   EXPECT_EQ(kills, 3 * kStageCount);

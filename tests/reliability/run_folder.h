@@ -2,6 +2,7 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -52,6 +53,7 @@ inline pid_t startRun(const fs::path& scene, const fs::path& dir, bool resume, i
   std::fflush(nullptr);  // the child must not write this process's buffered output again
   const pid_t pid = ::fork();
   if (pid == 0) {
+    ::setpgid(0, 0);  // its own process group: the test can end an ffmpeg a kill orphaned (killGroup)
     const std::string sceneArg = scene.string(), dirArg = dir.string(), threadsArg = std::to_string(threads);
     std::vector<const char*> argv = {SURGE_BINARY, "run",      sceneArg.c_str(),   "--out",
                                      dirArg.c_str(), "--quiet", "--threads", threadsArg.c_str()};
@@ -63,6 +65,19 @@ inline pid_t startRun(const fs::path& scene, const fs::path& dir, bool resume, i
     ::_exit(127);
   }
   return pid;
+}
+
+// Ends what is left of a run started by startRun (an ffmpeg orphaned by killing surge alone), then removes its
+// folder, again while a dying process may still add a file.
+inline void killGroupAndRemove(pid_t pid, const fs::path& dir) {
+  ::kill(-pid, SIGKILL);
+  std::error_code error;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    fs::remove_all(dir, error);
+    if (!error) return;
+    ::usleep(10000);
+  }
+  FAIL() << "cannot remove " << dir << ": " << error.message();
 }
 
 inline int waitExit(pid_t pid) {
