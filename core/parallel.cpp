@@ -4,6 +4,7 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 
@@ -26,6 +27,16 @@ void parallelFor(size_t begin, size_t end, const std::function<void(size_t, size
         }
       },
       tbb::simple_partitioner());
+}
+
+void runIsolated(const std::function<void()>& work) {
+  // A loop of one item with a context of its own: the tasks spawned inside bind to it, not to the enclosing
+  // loop's context, so that loop's cancellation does not reach them; an exception from `work` still
+  // propagates to the caller.
+  tbb::task_group_context isolated(tbb::task_group_context::isolated);
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, 1, 1), [&](const tbb::blocked_range<int>&) { work(); },
+      tbb::simple_partitioner(), isolated);
 }
 
 struct ThreadLimit::Impl {

@@ -14,6 +14,12 @@ namespace surge {
 // Runs body(chunkBegin, chunkEnd) for chunks of `grain` items covering [begin, end).
 void parallelFor(size_t begin, size_t end, const std::function<void(size_t, size_t)>& body, size_t grain = 1024);
 
+// Runs `work` (on this thread) so that the parallel loops inside it, ours and OpenVDB's, finish even when an
+// enclosing parallelFor is cancelled because another of its chunks threw. Without it they would return early
+// with part of their work skipped, and a frame computed beside a failing one would be written wrong. Use it
+// for each item of a loop whose items write their own outputs (the surfacer's frames).
+void runIsolated(const std::function<void()>& work);
+
 // Sums chunkSum(chunkBegin, chunkEnd) over fixed chunks, adding the partial sums in chunk order.
 template <typename T, typename ChunkSum>
 T parallelSum(size_t begin, size_t end, ChunkSum chunkSum, size_t grain = 4096) {

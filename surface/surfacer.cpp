@@ -562,9 +562,11 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
           if (const long far = farParticle(frame, resolve(frame, scene).voxel); far >= 0)
             throw InputError(path.string(), "vertex " + std::to_string(far),
                              "lies more than 2^22 voxels (surface.voxel_size) from the origin");
-          surfaceFrameWith(frame, scene, framePath(dir, "surface", f, "vdb"),
-                           framePath(dir, "surface", f, "ply"),
-                           colliders.empty() ? std::vector<SurfaceCollider>() : colliders.atFrame(f));
+          // Isolated: a frame beside one that fails runs to its end and is written whole (runIsolated).
+          runIsolated([&] {
+            surfaceFrameWith(frame, scene, framePath(dir, "surface", f, "vdb"), framePath(dir, "surface", f, "ply"),
+                             colliders.empty() ? std::vector<SurfaceCollider>() : colliders.atFrame(f));
+          });
           const std::lock_guard<std::mutex> lock(advance);
           progress.advance();
         }
