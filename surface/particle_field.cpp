@@ -305,7 +305,13 @@ BlockField rasterizeField(const FieldParticles& particles, const FieldParameters
             inBand |= phi > -band && phi < band;
             values[a] = phi;
           }
-          if (distance && !inBand && !only) continue;
+          // A block with no voxel in the band is dropped, and the level set's flood fill gives it a sign from
+          // its neighbours. The anisotropic field is re-distanced by OpenVDB from a raw grid whose blocks keep
+          // every voxel, where that fill reads the sign of the last voxel of the block before it in z order: at
+          // a slanted face, an outside block dropped above an inside corner came out inside, a lump 4 to 6
+          // spacings high on the face and an open mesh (Surfacer.SlantedSlab...). So its blocks are all kept,
+          // at about a fifth more time; giving dropped blocks their known sign as tiles would be cheaper.
+          if (distance && !inBand && !only && !anisotropic) continue;
           kept[t] = std::move(values);
         }
       },

@@ -218,9 +218,12 @@ TEST(Bodies, ABodyAtRestStillFeelsTheWater) {
   EXPECT_GT(moved, 0.03);
 }
 
-// Without gravity and away from the walls, a ball shot into a blob of water: what the ball loses the water
-// gains. The total momentum of both stays within 2% of the ball's initial momentum over half a second (the
-// coupling lags a step: the ball feels the water's push one step late).
+// Without gravity and away from the walls (the water stays 0.24 m or more from them), a ball shot into a blob of
+// water: what the ball loses the water gains. With the impulse still owed to the ball counted (below), the total
+// momentum of both stays within 2% of the ball's initial momentum over half a second. What is left is that the
+// owed impulse is estimated from the frame's mean force: during the impact the force changes by half within a
+// frame, 0.6% of the momentum. Measured: 0.48% at frame 5, 0.16% at frame 15; without the owed impulse, 1.6%
+// in this build and 2.8% in the sanitizer build, which the old bound of 2% did not allow for.
 TEST(Bodies, MomentumIsExchangedWithTheFluid) {
   const Scene scene = parseScene(R"({"name": "shot", "dimensions": 3,
     "domain": {"min": [0, 0, 0], "max": [1, 1, 1]}, "particle_spacing": 0.02, "gravity": [0, 0, 0],
@@ -235,13 +238,20 @@ TEST(Bodies, MomentumIsExchangedWithTheFluid) {
   const double particleMass = solver.particleMass();
   const double ballMass = 1500 * 4.0 / 3.0 * M_PI * std::pow(0.05, 3);
   const Eigen::Vector3d initial = ballMass * rows[0].velocity;
+  // The coupling is explicit (docs/bodies.md): the fluid's push of a step reaches the ball in the next, so at a
+  // frame's end the last step's impulse F dt has left the fluid but not yet reached the ball. It is counted
+  // with the ball, F taken as the frame's mean force bodies.csv reports (the last step's within a few percent:
+  // the force changes little over a frame).
+  const double step = 1.0 / (scene.output.fps * scene.solver.substeps);
   for (int f = 0; f <= 15; f += 5) {
     const ParticleFrame frame = readParticlePly(framePath(dir, "particles", f, "ply"));
     Eigen::Vector3d fluid = Eigen::Vector3d::Zero();
     for (size_t i = 0; i < frame.size(); ++i) fluid += particleMass * frame.velocity[i].cast<double>();
-    const Eigen::Vector3d total = fluid + ballMass * rows[f].velocity;
-    std::printf("frame %2d: ball %.4f, fluid %.4f, total %.4f kg m/s (x)\n", f, ballMass * rows[f].velocity.x(),
-                fluid.x(), total.x());
+    const Eigen::Vector3d owed = f > 0 ? Eigen::Vector3d(rows[f].force * step) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d total = fluid + ballMass * rows[f].velocity + owed;
+    std::printf("frame %2d: ball %.4f, owed to it %.4f, fluid %.4f, total %.4f kg m/s (x), %.2f%% off\n", f,
+                ballMass * rows[f].velocity.x(), owed.x(), fluid.x(), total.x(),
+                100 * (total - initial).norm() / initial.norm());
     EXPECT_NEAR((total - initial).norm(), 0.0, 0.02 * initial.norm()) << "frame " << f;
   }
   EXPECT_LT(rows[15].velocity.x(), 0.8);  // the water slowed the ball
