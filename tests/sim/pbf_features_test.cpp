@@ -89,8 +89,13 @@ TEST(PbfFeatures, VorticityConfinementKeepsTheSwirl) {
   }
   const float h = static_cast<float>(base.solver.kernel_radius);
   const double without = totalVorticity(run(openTank({}), frame, 30), h);
-  const double with = totalVorticity(run(openTank({"solver.vorticity_epsilon=0.05"}), frame, 30), h);
-  EXPECT_GT(with, 1.1 * without) << "with " << with << " without " << without;
+  // Since omega is the curl in 1/s (eq. 15 with the particle volume), epsilon is in m/s and the confinement's
+  // acceleration is epsilon |omega|: at 0.5 m/s about 5 m/s^2 at the swirl's 10 1/s, over the 0.25 s run as
+  // much as the swirl's own speed. Without it the total vorticity left varies by about 10% with round-off
+  // (at epsilon 0.05 this build read 1.18 times it and the sanitizer build 1.03), so 30% more is asked for.
+  // Measured: 1.90 times.
+  const double with = totalVorticity(run(openTank({"solver.vorticity_epsilon=0.5"}), frame, 30), h);
+  EXPECT_GT(with, 1.3 * without) << "with " << with << " without " << without;
 }
 
 // The particle-scale velocity noise XSPH acts on: the mean squared difference between each velocity and the
