@@ -88,9 +88,11 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   const int framesLeft =
       written.empty() ? scene.output.frames + 1 : std::max(0, scene.output.frames - written.back());
   double freed = 0;  // a new run first removes an earlier run's frames from the folder
-  for (const char* sub : {"particles", "surface", "frames"})
+  for (const char* sub : {"particles", "surface", "frames"}) {
+    if (resume) break;
     for (const auto& entry : fs::recursive_directory_iterator(dir / sub, error))
-      if (!resume && entry.is_regular_file(error)) freed += double(entry.file_size(error));
+      if (entry.is_regular_file(error)) freed += double(entry.file_size(error));
+  }
   checkFreeSpace(dir, "--out", double(framesLeft) * (28.0 * double(scene.particleCount()) + 512.0) - freed,
                  std::to_string(framesLeft) + " particle frames");
   checkOutputFolder(dir);

@@ -161,13 +161,15 @@ void checkFreeSpace(const fs::path& dir, const std::string& key, double bytes, c
   if (::statvfs(existing.c_str(), &info) != 0) return;  // a file system that cannot say: left to the writes
   const double free = double(info.f_bavail) * double(info.f_frsize);
   if (bytes <= free) return;
-  auto size = [](double b) {
-    char text[32];
-    std::snprintf(text, sizeof text, b >= 1e9 ? "%.1f GB" : "%.1f MB", b >= 1e9 ? b / 1e9 : b / 1e6);
-    return std::string(text);
-  };
   throw InputError(dir.string(), key,
-                   what + " need about " + size(bytes) + " and its file system has " + size(free) + " free");
+                   what + " need about " + formatBytes(bytes) + " and its file system has " + formatBytes(free) +
+                       " free");
+}
+
+std::string formatBytes(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, bytes >= 1e9 ? "%.1f GB" : "%.1f MB", bytes >= 1e9 ? bytes / 1e9 : bytes / 1e6);
+  return text;
 }
 
 }  // namespace surge

@@ -22,6 +22,9 @@ std::string writeFailure(int error);
 // a run that would fill the disk is refused before it starts. `what` says what needs the space.
 void checkFreeSpace(const fs::path& dir, const std::string& key, double bytes, const std::string& what);
 
+// "12.3 MB" or "4.5 GB", for messages about memory and disk space.
+std::string formatBytes(double bytes);
+
 // dir/sub/frame_NNNNN.ext: five digits, more for frames above 99,999 (output.frames reaches 10^7).
 fs::path framePath(const fs::path& dir, const std::string& sub, int frame, const std::string& ext);
 

@@ -601,13 +601,12 @@ double runawaySpeed(const Scene& scene) {
       colliders = std::max(colliders, ((b.position - a.position).head(d).norm() + turn * diagonal) / dt);
     }
   if (!scene.attractor.keyframes.empty()) {
-    attractor = std::sqrt(std::abs(scene.attractor.strength) * scene.attractor.radius);
+    double moving = 0;  // the attractor's fastest keyframed speed
     for (size_t k = 1; k < scene.attractor.keyframes.size(); ++k) {
       const AttractorKeyframe &a = scene.attractor.keyframes[k - 1], &b = scene.attractor.keyframes[k];
-      if (b.time > a.time)
-        attractor = std::max(attractor, std::sqrt(std::abs(scene.attractor.strength) * scene.attractor.radius) +
-                                            (b.position - a.position).head(d).norm() / (b.time - a.time));
+      if (b.time > a.time) moving = std::max(moving, (b.position - a.position).head(d).norm() / (b.time - a.time));
     }
+    attractor = std::sqrt(std::abs(scene.attractor.strength) * scene.attractor.radius) + moving;
   }
   const double fall = std::sqrt(2 * scene.gravity.head(d).norm() * diagonal);
   // PBF's projection moves a particle up to about a spacing a step, and the velocity is that move over the step;
@@ -666,15 +665,10 @@ void checkSimulationMemory(const Scene& scene) {
   const size_t count = scene.particleCount();
   const double bytes = double(count) * double(bytesPerParticleEstimate(scene.dimensions));
   const MemoryLimit memory = memoryLimit();
-  auto size = [](double b) {
-    char text[32];
-    std::snprintf(text, sizeof text, b >= 1e9 ? "%.1f GB" : "%.1f MB", b >= 1e9 ? b / 1e9 : b / 1e6);
-    return std::string(text);
-  };
   if (count > (size_t(1) << 31) || bytes > 0.8 * memory.bytes)
     throw InputError(scene.source, "particle_spacing",
-                     std::to_string(count) + " particles need about " + size(bytes) + " to simulate, more than " +
-                         memory.source + " " + size(memory.bytes) + " allow (80%)");
+                     std::to_string(count) + " particles need about " + formatBytes(bytes) + " to simulate, more than " +
+                         memory.source + " " + formatBytes(memory.bytes) + " allow (80%)");
 }
 
 std::string sceneToJson(const Scene& scene) {
