@@ -133,8 +133,10 @@ struct CameraSettings {
 struct RenderSettings {
   int width = 960;
   int height = 540;
-  int samples = 8;  // per pixel (path tracer; the demo's 120 frames take about 2.5 minutes on 2 cores)
+  int samples = 2;  // per pixel (path tracer), at least; see edge_samples and docs/performance.md
   int max_depth = 8;  // path segments before a path stops (Russian roulette may stop it sooner)
+  int denoise = 1;       // 1: the path tracer's image goes through the edge-aware filter (render/denoiser.h)
+  int edge_samples = 4;  // samples a pixel takes in all when its first ones straddle surfaces (<= samples: none)
   std::string quality = "standard";  // standard: the numbers above; preview and final scale them (renderer.h)
   CameraSettings camera;
   Eigen::Vector3d water_color = Eigen::Vector3d(0.15, 0.45, 0.8);

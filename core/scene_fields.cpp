@@ -250,6 +250,11 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.integer("samples", s.render.samples, atLeast(1, "samples per pixel", "", 65536));
     v.integer("max_depth", s.render.max_depth,
               atLeast(1, "path tracer: most surfaces a path meets (Russian roulette may stop it sooner)", "", 1000));
+    v.integer("denoise", s.render.denoise,
+              atLeast(0, "1: filter the path tracer's noise, guided by its normals, depths and albedos", "", 1));
+    v.integer("edge_samples", s.render.edge_samples,
+              atLeast(0, "samples a pixel takes in all where its first samples straddle surfaces (an edge, a "
+                         "splash); not above `samples`: every pixel takes `samples`", "", 65536));
     v.choice("quality", s.render.quality, {"standard", "preview", "final"},
              info("standard: width, height, samples and max_depth as given; preview: half the resolution, 4 "
                   "samples, depth 4; final: at least 720 pixels high, 64 samples, depth 12"));

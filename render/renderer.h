@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "core/files.h"
@@ -27,7 +28,26 @@ RenderSettings resolvedRenderSettings(const RenderSettings& settings);
 
 // What a render cost, for the benchmark.
 struct RenderStats {
-  uint64_t rays = 0;  // path segments and shadow rays cast
+  uint64_t rays = 0;        // path segments and shadow rays cast
+  uint64_t edgePixels = 0;  // pixels that took edge_samples
+};
+
+// Path-traces frame after frame with one Embree device, keeping its buffers from frame to frame (renderFrames
+// uses one for a stage; renderMesh below makes one for a single image).
+class PathTracer {
+ public:
+  PathTracer();
+  ~PathTracer();
+  PathTracer(const PathTracer&) = delete;
+  PathTracer& operator=(const PathTracer&) = delete;
+
+  // As renderMesh with the colliders, below.
+  Image render(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders, const Scene& scene, int frame,
+               RenderStats* stats = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 // Path-traces the water mesh with the scene's tank, ground, sky and camera at the resolved resolution and

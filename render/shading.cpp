@@ -30,6 +30,9 @@ constexpr int kMaxShadowCrossings = 16;
 // paints an isolated white pixel ("firefly"). The clamp biases those glints a little dark and leaves
 // everything else, including the white furnace (radiance 1), untouched.
 constexpr float kSampleClamp = 32.0f;
+// The denoiser's guide chain meets at most this many surfaces (glass walls, water) before it gives up on
+// finding a diffuse one.
+constexpr int kFeatureChain = 8;
 
 Vec3 reflect(const Vec3& direction, const Vec3& normal) {
   return direction - 2.0f * direction.dot(normal) * normal;
@@ -220,7 +223,76 @@ struct PathState {
   bool splitWater = true;
   int glassSplits = 2;
   int glassPasses = 0;
+  bool onChain = false;  // the denoiser's guide chain goes the same way (GuideChain)
 };
+
+// The denoiser's guides (SampleFeatures) come from a chain of rays that passes glass walls straight, refracts at
+// water (reflects under total internal reflection) and stops at the first diffuse surface. The chain rides
+// along the path while the path goes its way (it does through the camera's first splits, which follow both
+// ways), using the path's own hits, and is traced on its own (continueChain) only from where they part.
+struct GuideChain {
+  SampleFeatures* features = nullptr;
+  bool firstSeen = false, done = false;
+  int events = 0;  // surfaces met
+
+  // Records a surface the chain met after `travelled` along it; returns false when the chain ends here.
+  bool meet(const Shading& shading, const Hit& hit, float travelled) {
+    if (++events > kFeatureChain) return finish();
+    if (hit.kind == SurfaceKind::TankGlass) return true;
+    if (!firstSeen) {
+      features->normal = hit.normal;
+      features->point = hit.point;
+      features->depth = travelled;
+      firstSeen = true;
+    }
+    if (hit.kind == SurfaceKind::Water) return true;
+    features->albedo = hit.kind == SurfaceKind::Ground     ? groundAlbedoAt(shading, hit.point, travelled)
+                       : hit.kind == SurfaceKind::Collider ? hit.albedo
+                                                           : Vec3::Constant(shading.tankAlbedo);
+    return finish();
+  }
+  bool finish() {
+    done = true;
+    return false;
+  }
+};
+
+// The chain on its own from `ray` on (inside water or not, `travelled` so far).
+void continueChain(const RayScene& world, const Shading& shading, Ray ray, bool inside, float travelled,
+                   GuideChain& chain, PathStats& stats) {
+  while (!chain.done) {
+    Hit hit;
+    ++stats.rays;
+    if (!world.intersect(ray, kFar, hit)) {
+      chain.finish();
+      return;
+    }
+    travelled += hit.distance;
+    if (!chain.meet(shading, hit, travelled)) return;
+    if (hit.kind == SurfaceKind::TankGlass) {
+      ray.origin = hit.passPoint;
+      continue;
+    }
+    float fresnel = 1;
+    Vec3 reflected, refracted;
+    Hit face = hit;
+    if (!waterEvent(shading, hit.normal, hit, inside, ray.direction, fresnel, reflected, refracted)) {
+      face.normal = hit.geometricNormal;
+      if (!waterEvent(shading, face.normal, face, inside, ray.direction, fresnel, reflected, refracted)) {
+        chain.finish();
+        return;
+      }
+    }
+    if (fresnel < 1.0f) {
+      ray.origin = hit.passPoint;
+      ray.direction = refracted;
+      inside = !inside;
+    } else {
+      ray.origin = hit.leavePoint;
+      ray.direction = reflected;
+    }
+  }
+}
 
 // The light a path gathers from its state on. On the camera's direct view, the first water surface met sends
 // both a reflected and a refracted path, weighted F and 1 - F, instead of choosing one: the water then shows
@@ -229,20 +301,28 @@ struct PathState {
 // behind them still splits once. Later surfaces choose at random (with the Fresnel probability, which keeps
 // the estimate unbiased).
 Vec3 gather(const RayScene& world, const Shading& shading, PathState path, SampleRandom& random,
-            PathStats& stats) {
+            PathStats& stats, Vec3* reflection = nullptr, GuideChain* chain = nullptr) {
   Vec3 radiance = Vec3::Zero();
   Vec3& throughput = path.throughput;
   Ray& ray = path.ray;
+  // Where the path leaves the chain's way, the chain goes on alone along `next`.
+  const auto partFromChain = [&](const Ray& next, bool inside) {
+    if (!path.onChain) return;
+    path.onChain = false;
+    continueChain(world, shading, next, inside, path.travelled, *chain, stats);
+  };
   for (; path.depth < shading.maxDepth; ++path.depth) {
     Hit hit;
     ++stats.rays;
     if (!world.intersect(ray, kFar, hit)) {
       radiance += throughput.cwiseProduct(skyRadiance(shading, ray.direction) +
                                           (path.specular ? sunDisc(shading, ray.direction) : Vec3::Zero()));
-      break;
+      if (path.onChain) chain->finish();
+      return radiance;
     }
     if (path.inside) throughput = throughput.cwiseProduct(absorb(shading, hit.distance));
     if (path.specular) path.travelled += hit.distance;
+    if (path.onChain && !chain->meet(shading, hit, path.travelled)) path.onChain = false;
     if (path.specular && hit.kind == SurfaceKind::Ground) {
       // Haze over the ground seen from the camera, growing with the square of the distance: nothing on the
       // tank, the horizon colour far away, so the ground plane's edge melts into the sky.
@@ -258,8 +338,10 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
       if (!waterEvent(shading, hit.normal, hit, path.inside, ray.direction, fresnel, reflected, refracted)) {
         face.normal = hit.geometricNormal;  // the smooth normal disagrees with the face here
         if (!waterEvent(shading, face.normal, face, path.inside, ray.direction, fresnel, reflected,
-                        refracted))
-          break;
+                        refracted)) {
+          if (path.onChain) chain->finish();
+          return radiance;
+        }
       }
       if (path.splitWater && fresnel < 1.0f) {
         PathState mirror = path, through = path;
@@ -274,10 +356,13 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
         through.ray.direction = refracted;
         through.inside = !path.inside;
         through.throughput *= 1.0f - fresnel;
-        return radiance + gather(world, shading, mirror, random, stats) +
-               gather(world, shading, through, random, stats);
+        mirror.onChain = false;  // the chain refracts
+        const Vec3 mirrored = gather(world, shading, mirror, random, stats);
+        if (reflection) *reflection += mirrored;
+        return radiance + mirrored + gather(world, shading, through, random, stats, nullptr, chain);
       }
       if (fresnel >= 1.0f || random.next() < fresnel) {
+        if (fresnel < 1.0f) partFromChain(Ray{hit.passPoint, refracted}, !path.inside);
         ray.origin = hit.leavePoint;
         ray.direction = reflected;
       } else {
@@ -302,10 +387,12 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
         mirror.throughput *= reflectance;
         through.ray.origin = hit.passPoint;  // straight on: the pane is too thin to shift the ray
         through.throughput *= 1.0f - reflectance;
-        return radiance + gather(world, shading, mirror, random, stats) +
-               gather(world, shading, through, random, stats);
+        mirror.onChain = false;  // the chain passes
+        return radiance + gather(world, shading, mirror, random, stats, reflection) +
+               gather(world, shading, through, random, stats, reflection, chain);
       }
       if (random.next() < reflectance) {
+        partFromChain(Ray{hit.passPoint, ray.direction}, path.inside);
         ray.origin = hit.leavePoint;
         ray.direction = reflected;
       } else {
@@ -341,20 +428,32 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
       throughput /= survive;
     }
   }
+  partFromChain(ray, path.inside);  // the path stopped (roulette, depth) where the chain had not
   return radiance;
 }
 
 }  // namespace
 
 Vec3 traceRadiance(const RayScene& world, const Shading& shading, const Ray& cameraRay, SampleRandom& random,
-                   PathStats* stats) {
+                   PathStats* stats, SampleFeatures* features) {
   PathStats local;
   PathState path;
   path.ray = cameraRay;
-  const Vec3 radiance = gather(world, shading, path, random, local);
+  Vec3 reflection = Vec3::Zero();
+  GuideChain chain;
+  if (features) {
+    *features = SampleFeatures{};
+    chain.features = features;
+    path.onChain = true;
+  }
+  const Vec3 radiance = gather(world, shading, path, random, local, features ? &reflection : nullptr,
+                               features ? &chain : nullptr);
+  if (features) features->reflection = reflection;
   if (stats) stats->rays += local.rays;
   const float peak = radiance.maxCoeff();
-  return peak > kSampleClamp ? Vec3(radiance * (kSampleClamp / peak)) : radiance;
+  if (!(peak > kSampleClamp)) return radiance;
+  if (features) features->reflection *= kSampleClamp / peak;
+  return radiance * (kSampleClamp / peak);
 }
 
 float toneMap(float linear, float exposure) {

@@ -65,9 +65,25 @@ struct PathStats {
   uint64_t rays = 0;
 };
 
+// What a camera ray sees besides its light, for the denoiser (render/denoiser.h), along a chain of its own
+// that passes glass walls, refracts at water (reflects under total internal reflection) and stops at the first
+// diffuse surface: the first surface other than glass (its shading normal, facing the camera, the point and its
+// distance along the chain; all zero for the sky) and that diffuse surface's albedo (1 if the chain reaches none). The
+// chain draws no random numbers: the light is the same with or without it. Also the part of the light that
+// the camera's first water surface reflects (the mirror half of its split, gather in shading.cpp): nearly free
+// of noise, full of the surface's detail, and left out of the filter.
+struct SampleFeatures {
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+  Eigen::Vector3f point = Eigen::Vector3f::Zero();  // where the chain met that first surface
+  float depth = 0;
+  Eigen::Vector3f albedo = Eigen::Vector3f::Ones();
+  Eigen::Vector3f reflection = Eigen::Vector3f::Zero();
+};
+
 // Linear RGB light arriving along a camera ray: one path-traced sample.
 Eigen::Vector3f traceRadiance(const RayScene& world, const Shading& shading, const Ray& ray,
-                              SampleRandom& random, PathStats* stats = nullptr);
+                              SampleRandom& random, PathStats* stats = nullptr,
+                              SampleFeatures* features = nullptr);
 
 // Linear light to display: exposure, then the ACES filmic curve fitted by Narkowicz (2015), in [0, 1].
 float toneMap(float linear, float exposure);

@@ -201,6 +201,7 @@ TEST(PathTracerTest, FresnelMakesWaterReflectMoreAtGrazingAngles) {
 
 TEST(PathTracerTest, QualityPresetsSetResolutionAndSamples) {
   RenderSettings settings;  // 960 x 540
+  settings.samples = 8;
   settings.quality = "preview";
   EXPECT_EQ(resolvedRenderSettings(settings).width, 480);
   EXPECT_EQ(resolvedRenderSettings(settings).height, 270);

@@ -115,8 +115,9 @@ TEST(RendererTest, ObjectOnTheLeftAppearsInTheLeftHalf) {
 }
 
 TEST(RendererTest, SameBytesWithOneAndTwoThreads) {
+  // 4x3 tiles, partial ones; the denoiser and the edge samples' second round on.
   const Scene scene =
-      unitTankScene(R"("width": 100, "height": 70, "samples": 3)");  // 4x3 tiles, partial ones
+      unitTankScene(R"("width": 100, "height": 70, "samples": 3, "denoise": 1, "edge_samples": 7)");
   const TriangleMesh mesh = boxMesh({0.2f, 0.0f, 0.3f}, {0.6f, 0.4f, 0.8f});
   Image one, two;
   {
