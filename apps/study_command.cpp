@@ -144,6 +144,12 @@ Sweep parseSweep(const std::string& text) {
   sweep.values = splitValues(text.substr(equals + 1));
   for (const std::string& value : sweep.values)
     if (value.empty()) throw InputError("--sweep", sweep.key, "an empty value in '" + text + "'");
+  // The study simulates only: a surface or render setting would give every run the same simulation.
+  for (const char* stage : {"surface.", "render."})
+    if (sweep.key.rfind(stage, 0) == 0)
+      throw InputError("--sweep", sweep.key,
+                       "the study compares simulations, which this key does not change (render settings' image "
+                       "error against time: scripts/bench_render_quality.sh)");
   return sweep;
 }
 
