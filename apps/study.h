@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/files.h"
+#include "core/progress.h"
 #include "core/scene.h"
 
 namespace surge {
@@ -45,6 +46,20 @@ struct StudyRun {
   double frontRms = 0, heightRms = 0, fieldError = 0, error = 0;
 };
 
+// Runs `args` (args[0] "surge", args[1] its command) as a child surge process with stdout and stderr into
+// run.folder/log.txt, and fills the run's status, message (its last line when it failed), CPU and wall seconds
+// (wait4: all its threads) and peak memory. Throws Interrupted if the child was interrupted.
+void runChild(StudyRun& run, std::vector<std::string> args);
+
+// A study of render settings (every swept key render.*, apps/render_study.cpp): the scene simulated and
+// surfaced once into dir/base (`baseOverrides` applied), then each run renders those surfaces with its own
+// settings (`surge render`, a child process each, CPU seconds measured), and its error is the RMS difference of
+// its frames' 8-bit sRGB values from those of the reference, the unfiltered run of most CPU seconds. Fills runs; returns
+// the reference's position, or -1. Throws RunError if the base simulation or surfacing fails.
+int runRenderStudy(const fs::path& scenePath, const fs::path& dir, const std::vector<std::string>& baseOverrides,
+                   std::vector<StudyRun>& runs, const std::vector<std::vector<std::string>>& runOverrides,
+                   int threads, Progress& progress);
+
 // The run's measures (status, message, CPU and wall seconds, peak memory) as run.json in its folder, written by
 // the task that ran it and read by the report (surge study --slurm runs them in different jobs). A run without
 // one reads as failed, "did not run".
@@ -64,8 +79,9 @@ void writeStudyCsv(const fs::path& path, const std::vector<Sweep>& sweeps, const
 
 // error_vs_cpu.png (Pareto front marked) and front_vs_time.png in dir, through a gnuplot script (plots.gp).
 // Returns an empty string, or a one-line warning when gnuplot is missing or failed (the study still succeeds).
+// errorLabel names the error's axis; the dam-break plot is drawn only when some run has stats.
 std::string writeStudyPlots(const fs::path& dir, const std::vector<Sweep>& sweeps, const std::vector<StudyRun>& runs,
-                            int reference, bool damBreak);
+                            int reference, const std::string& errorLabel);
 
 // The runs on the Pareto front of (CPU seconds, error): none cheaper is at least as accurate. Sorted by CPU.
 std::vector<int> paretoFront(const std::vector<StudyRun>& runs);

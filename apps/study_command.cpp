@@ -90,14 +90,11 @@ std::string lastLine(const fs::path& path) {
   return last;
 }
 
-// Runs `surge sim` for one combination with stdout and stderr into the run folder's log.txt, and measures it.
-void runOne(StudyRun& run, const std::string& scenePath, const std::vector<std::string>& overrides, int threads) {
+}  // namespace
+
+void runChild(StudyRun& run, std::vector<std::string> args) {
   fs::create_directories(run.folder);
-  const std::string out = run.folder.string(), log = (run.folder / "log.txt").string();
-  const std::string threadText = std::to_string(threads);
-  std::vector<std::string> args = {"surge", "sim", scenePath, "--quiet", "--out", out};
-  if (threads > 0) args.insert(args.end(), {"--threads", threadText});
-  for (const std::string& assignment : overrides) args.insert(args.end(), {"--set", assignment});
+  const std::string log = (run.folder / "log.txt").string();
   std::vector<char*> argv;
   for (std::string& arg : args) argv.push_back(arg.data());
   argv.push_back(nullptr);
@@ -110,12 +107,12 @@ void runOne(StudyRun& run, const std::string& scenePath, const std::vector<std::
   pid_t pid = 0;
   const int spawned = posix_spawn(&pid, "/proc/self/exe", &files, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&files);
-  if (spawned != 0) throw RunError("study: cannot start surge sim: " + std::string(std::strerror(spawned)));
+  if (spawned != 0) throw RunError("study: cannot start surge " + args[1] + ": " + std::string(std::strerror(spawned)));
 
   int status = 0;
   rusage usage{};
   while (wait4(pid, &status, 0, &usage) < 0)
-    if (errno != EINTR) throw RunError("study: lost the run in " + out + ": " + std::strerror(errno));
+    if (errno != EINTR) throw RunError("study: lost the run in " + run.folder.string() + ": " + std::strerror(errno));
   run.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   run.cpuSeconds = usage.ru_utime.tv_sec + 1e-6 * usage.ru_utime.tv_usec + usage.ru_stime.tv_sec +
                    1e-6 * usage.ru_stime.tv_usec;
@@ -130,6 +127,16 @@ void runOne(StudyRun& run, const std::string& scenePath, const std::vector<std::
       run.message = WIFSIGNALED(status) ? "killed by signal " + std::to_string(WTERMSIG(status))
                                         : "exit status " + std::to_string(code);
   }
+}
+
+namespace {
+
+// Runs `surge sim` for one combination with stdout and stderr into the run folder's log.txt, and measures it.
+void runOne(StudyRun& run, const std::string& scenePath, const std::vector<std::string>& overrides, int threads) {
+  std::vector<std::string> args = {"surge", "sim", scenePath, "--quiet", "--out", run.folder.string()};
+  if (threads > 0) args.insert(args.end(), {"--threads", std::to_string(threads)});
+  for (const std::string& assignment : overrides) args.insert(args.end(), {"--set", assignment});
+  runChild(run, args);
   readRunStats(run);
 }
 
@@ -144,12 +151,9 @@ Sweep parseSweep(const std::string& text) {
   sweep.values = splitValues(text.substr(equals + 1));
   for (const std::string& value : sweep.values)
     if (value.empty()) throw InputError("--sweep", sweep.key, "an empty value in '" + text + "'");
-  // The study simulates only: a surface or render setting would give every run the same simulation.
-  for (const char* stage : {"surface.", "render."})
-    if (sweep.key.rfind(stage, 0) == 0)
-      throw InputError("--sweep", sweep.key,
-                       "the study compares simulations, which this key does not change (render settings' image "
-                       "error against time: scripts/bench_render_quality.sh)");
+  // A surface setting would give every run the same simulation and nothing to compare.
+  if (sweep.key.rfind("surface.", 0) == 0)
+    throw InputError("--sweep", sweep.key, "the study compares simulations or renders, not surfaces");
   return sweep;
 }
 
@@ -188,6 +192,15 @@ void addStudyCommand(CLI::App& app) {
     for (size_t a = 0; a < sweeps.size(); ++a)
       for (size_t b = 0; b < a; ++b)
         if (sweeps[a].key == sweeps[b].key) throw InputError("--sweep", sweeps[a].key, "swept twice");
+    // Render settings are swept alone: the scene is simulated once and each run renders it (render_study.cpp).
+    size_t renderKeys = 0;
+    for (const Sweep& sweep : sweeps) renderKeys += sweep.key.rfind("render.", 0) == 0;
+    const bool renderStudy = renderKeys > 0;
+    if (renderStudy && renderKeys < sweeps.size())
+      throw InputError("--sweep", sweeps.front().key, "sweep render settings alone or simulation settings alone");
+    if (renderStudy && (options->slurm.enabled || options->runIndex >= 0 || options->report))
+      throw InputError("--sweep", sweeps.front().key,
+                       "render settings are swept in one local study (no --slurm, --run-index or --report)");
 
     // Every combination's scene is loaded (and so checked) before anything is written or run.
     std::vector<std::string> base = common.overrides;
@@ -241,6 +254,22 @@ void addStudyCommand(CLI::App& app) {
       writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << sceneToJson(scene); });
     const auto start = std::chrono::steady_clock::now();
     TerminalProgress progress(!common.quiet);
+    if (renderStudy) {
+      std::vector<std::vector<std::string>> renderOverrides;
+      for (const std::vector<std::string>& assignments : overrides)
+        renderOverrides.emplace_back(assignments.end() - sweeps.size(), assignments.end());
+      const int reference = runRenderStudy(options->scene, dir, base, runs, renderOverrides, common.threads, progress);
+      writeStudyCsv(dir / "study.csv", sweeps, runs);
+      const std::string warning =
+          writeStudyPlots(dir, sweeps, runs, reference, "image RMSE against the reference (8-bit sRGB values)");
+      if (!warning.empty()) std::fprintf(stderr, "surge: warning: %s\n", warning.c_str());
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      char line[512];
+      std::snprintf(line, sizeof line, "study: %zu renders in %.1f s, reference run %d -> %s", runs.size(), seconds,
+                    reference, (dir / "study.csv").string().c_str());
+      say(common, line);
+      return;
+    }
     progress.start("study", runs.size());
     for (size_t i = 0; i < runs.size(); ++i) {
       Progress::checkInterrupt();
@@ -258,7 +287,9 @@ void addStudyCommand(CLI::App& app) {
     const bool damBreak = isDamBreak(scene);
     const int reference = compareWithReference(runs, damBreak, scene.domain, scene.dimensions);
     writeStudyCsv(dir / "study.csv", sweeps, runs);
-    const std::string warning = writeStudyPlots(dir, sweeps, runs, reference, damBreak);
+    const std::string warning = writeStudyPlots(
+        dir, sweeps, runs, reference,
+        damBreak ? "RMS error of front and back height (m)" : "density field error (fraction)");
     if (!warning.empty()) std::fprintf(stderr, "surge: warning: %s\n", warning.c_str());
 
     int bad = 0;

@@ -270,7 +270,7 @@ void writeStudyCsv(const fs::path& path, const std::vector<Sweep>& sweeps, const
 }
 
 std::string writeStudyPlots(const fs::path& dir, const std::vector<Sweep>& sweeps, const std::vector<StudyRun>& runs,
-                            int reference, bool damBreak) {
+                            int reference, const std::string& errorLabel) {
   if (!onPath("gnuplot")) return "gnuplot is not installed: no plots (study.csv is complete)";
   std::string keys;
   for (const Sweep& sweep : sweeps) keys += (keys.empty() ? "" : "/") + sweep.key;
@@ -293,35 +293,38 @@ std::string writeStudyPlots(const fs::path& dir, const std::vector<Sweep>& sweep
      << "set output '" << (dir / "error_vs_cpu.png").string() << "'\n"
      << "set title \"Error against CPU time (" << keys << "); reference " << ref << "\" noenhanced\n"
      << "set xlabel 'CPU seconds (all threads)'\nset logscale x\nset logscale y\nset grid\n"
-     << "set ylabel '" << (damBreak ? "RMS error of front and back height (m)" : "density field error (fraction)")
-     << "'\nset key top right\n"
+     << "set ylabel '" << errorLabel << "'\nset key top right\n"
      << "plot '" << (dir / "plot_runs.dat").string() << "' using 1:2 with points pt 7 ps 1.2 title 'runs', \\\n"
      << "  '' using 1:2:3 with labels offset 0,1 font ',8' noenhanced notitle, \\\n"
      << "  '" << (dir / "plot_pareto.dat").string() << "' using 1:2 with linespoints lw 2 pt 6 ps 2 title 'Pareto front'\n";
-  gp << "set output '" << (dir / "front_vs_time.png").string() << "'\n"
-     << "set terminal pngcairo size 900,900 font 'sans,10'\n"
-     << "unset logscale\nset datafile separator ','\nset key outside right noenhanced\n"
-     << (reference >= 0 && std::isfinite(runs[reference].window)
-             ? "set arrow from " + format(runs[reference].window) +
-                   ", graph 0 to " + format(runs[reference].window) + ", graph 1 nohead dt 2\n" +
-                   "set label 'compared until here' at " + format(runs[reference].window) + ", graph 0.95 offset 0.5,0\n"
-             : std::string())
-     << "set multiplot layout 2,1 title \"Dam break measures per run (" << keys << ")\" noenhanced\n";
-  for (const char* measure : {"front_x", "back_height"}) {
-    gp << "set title '" << measure << "' noenhanced\nset xlabel 'time (s)'\nset ylabel '" << measure << " (m)' noenhanced\n"
-       << "plot ";
-    bool first = true;
-    for (const StudyRun& run : runs) {
-      if (run.time.empty()) continue;
-      gp << (first ? "" : ", \\\n  ") << "'" << (run.folder / "stats.csv").string() << "' every ::1 using "
-         << statsColumn("time") << ":" << statsColumn(measure) << " with lines " << (run.reference ? "lw 3 " : "lw 1 ")
-         << "title '" << label(run) << (run.reference ? " (ref)" : "") << (run.status != "ok" ? " (diverged)" : "")
-         << "'";
-      first = false;
+  bool anyStats = false;
+  for (const StudyRun& run : runs) anyStats = anyStats || !run.time.empty();
+  if (anyStats) {
+    gp << "set output '" << (dir / "front_vs_time.png").string() << "'\n"
+       << "set terminal pngcairo size 900,900 font 'sans,10'\n"
+       << "unset logscale\nset datafile separator ','\nset key outside right noenhanced\n"
+       << (reference >= 0 && std::isfinite(runs[reference].window)
+               ? "set arrow from " + format(runs[reference].window) +
+                     ", graph 0 to " + format(runs[reference].window) + ", graph 1 nohead dt 2\n" +
+                     "set label 'compared until here' at " + format(runs[reference].window) + ", graph 0.95 offset 0.5,0\n"
+               : std::string())
+       << "set multiplot layout 2,1 title \"Dam break measures per run (" << keys << ")\" noenhanced\n";
+    for (const char* measure : {"front_x", "back_height"}) {
+      gp << "set title '" << measure << "' noenhanced\nset xlabel 'time (s)'\nset ylabel '" << measure << " (m)' noenhanced\n"
+         << "plot ";
+      bool first = true;
+      for (const StudyRun& run : runs) {
+        if (run.time.empty()) continue;
+        gp << (first ? "" : ", \\\n  ") << "'" << (run.folder / "stats.csv").string() << "' every ::1 using "
+           << statsColumn("time") << ":" << statsColumn(measure) << " with lines " << (run.reference ? "lw 3 " : "lw 1 ")
+           << "title '" << label(run) << (run.reference ? " (ref)" : "") << (run.status != "ok" ? " (diverged)" : "")
+           << "'";
+        first = false;
+      }
+      gp << "\n";
     }
-    gp << "\n";
+    gp << "unset multiplot\n";
   }
-  gp << "unset multiplot\n";
   const fs::path script = dir / "plots.gp";
   writeFileAtomically(script, [&](std::ostream& out) { out << gp.str(); });
 

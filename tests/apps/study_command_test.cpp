@@ -72,12 +72,61 @@ TEST(StudyCommand, SweepWritesOneRowPerRunAndPicksTheCostliestAsReference) {
   EXPECT_TRUE(fs::exists(out / "runs" / "003_solver.iterations=4,solver.substeps=3" / "stats.csv"));
 }
 
+// Render settings swept: the scene is simulated and surfaced once (base/), each run renders it, and its error
+// is the image RMSE against the reference, the unfiltered run of most CPU seconds: here 16 samples unfiltered.
+// One sample is far off it (the noise of a single sample, tens of levels), the filter brings one sample closer,
+// and 16 filtered samples are closer still. Each run has its frames; the base's surfaces are not copied.
+TEST(StudyCommand, RenderSweepComparesImagesWithTheMostCostlyUnfilteredRun) {
+  const fs::path scene = writeTestScene("tiny3d.json", R"({
+    "name": "tiny3d", "dimensions": 3,
+    "domain": {"min": [0, 0, 0], "max": [0.8, 0.5, 0.4]},
+    "particle_spacing": 0.04,
+    "fluids": [{"box": {"min": [0, 0, 0], "max": [0.3, 0.3, 0.4]}}],
+    "output": {"fps": 30, "frames": 2},
+    "render": {"width": 96, "height": 54}
+  })");
+  const fs::path out = fs::path(testing::TempDir()) / "surge_render_study";
+  fs::remove_all(out);
+  const SurgeResult r = runSurge("study '" + scene.string() +
+                                 "' --quiet --sweep render.samples=1,16 --sweep render.denoise=0,1 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = readCsv(out / "study.csv");
+  ASSERT_EQ(rows.size(), 5u);
+  const int reference = column(rows[0], "reference"), error = column(rows[0], "error"),
+            status = column(rows[0], "status"), frames = column(rows[0], "frames");
+  ASSERT_GE(std::min({reference, error, status, frames}), 0);
+  for (size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i][status], "ok");
+    EXPECT_EQ(rows[i][frames], "3");
+    EXPECT_EQ(rows[i][reference], i == 3 ? "1" : "0");
+  }
+  // Rows: 1 sample unfiltered, 1 filtered, 16 unfiltered (the reference), 16 filtered.
+  const double one = std::stod(rows[1][error]), oneFiltered = std::stod(rows[2][error]),
+               sixteenFiltered = std::stod(rows[4][error]);
+  std::printf("image RMSE: 1 sample %.2f, filtered %.2f; 16 filtered %.2f\n", one, oneFiltered, sixteenFiltered);
+  EXPECT_EQ(std::stod(rows[3][error]), 0.0);
+  EXPECT_GT(one, 5.0);
+  EXPECT_LT(oneFiltered, one);
+  EXPECT_LT(sixteenFiltered, oneFiltered);
+  EXPECT_TRUE(fs::exists(out / "base" / "surface" / "frame_00002.ply"));
+  EXPECT_TRUE(fs::exists(out / "runs" / "003_render.samples=16,render.denoise=1" / "frames" / "frame_00002.png"));
+  EXPECT_TRUE(fs::exists(out / "error_vs_cpu.png"));
+  // Mixed with a simulation setting, refused before anything is written.
+  fs::remove_all(out);
+  const SurgeResult mixed = runSurge("study '" + scene.string() +
+                                     "' --quiet --sweep render.samples=1,2 --sweep solver.iterations=1,2 --out " +
+                                     out.string());
+  EXPECT_EQ(mixed.status, 2) << mixed.err;
+  EXPECT_EQ(std::count(mixed.err.begin(), mixed.err.end(), '\n'), 1) << mixed.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(StudyCommand, BadSweepsAreRefusedBeforeAnythingIsWritten) {
   const fs::path scene = writeTestScene("tiny.json", kTinyDamBreak);
   const fs::path out = fs::path(testing::TempDir()) / "surge_study_bad";
   fs::remove_all(out);
   for (const std::string sweep : {"solver.iterations", "=1,2", "solver.iterations=1,,2", "solver.no_such_key=1,2",
-                                  "solver.iterations=1,0", "render.samples=1,2", "surface.method=spheres,anisotropic"}) {
+                                  "solver.iterations=1,0", "surface.method=spheres,anisotropic"}) {
     const SurgeResult r = runSurge("study '" + scene.string() + "' --quiet --sweep '" + sweep + "' --out " + out.string());
     EXPECT_EQ(r.status, 2) << sweep << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
