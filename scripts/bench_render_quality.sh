@@ -3,7 +3,10 @@
 # demo run with REFERENCE_SAMPLES samples a pixel and no filter (once; kept beside the run and reused), then
 # prints, for each setting, the seconds a frame takes and the image error against that reference
 # (bench/render_quality.cpp). A reference of N samples is itself off by about 1/sqrt(N / 8) of the 8-sample
-# image's error: 1024 samples, 9%.
+# image's error: 1024 samples, 9%. It must have many more samples than the settings it judges: a pixel's
+# sample s draws the same random numbers beyond its first bounces in every image, so an image of 8 samples
+# shares them with 8 of the reference's (with 16, half of it: 8 unfiltered samples then look better than they
+# are; with 1024, under 1%).
 #
 #   scripts/bench_render_quality.sh [BUILD_DIR] [RUN_DIR] [FRAMES] [REFERENCE_SAMPLES] [SETTINGS...]
 # Defaults: build, out/dam_break (made with `surge run scenes/dam_break.json` if it has no surfaces), frames
