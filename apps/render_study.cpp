@@ -16,18 +16,6 @@ namespace surge {
 
 namespace {
 
-// Sum of squared differences of the 8-bit values of two frames, and how many values; false if the sizes differ.
-bool squaredDifference(const fs::path& a, const fs::path& b, double& sum, double& count) {
-  const Image x = readPng(a), y = readPng(b);
-  if (x.width != y.width || x.height != y.height) return false;
-  for (size_t i = 0; i < x.rgb.size(); ++i) {
-    const double d = double(x.rgb[i]) - double(y.rgb[i]);
-    sum += d * d;
-  }
-  count += double(x.rgb.size());
-  return true;
-}
-
 // The files of `from` hard-linked into `to` (copied where a link cannot be made): each run renders the base's
 // surfaces without copying them, and without a symbolic link, which surge refuses in an output folder.
 void linkFolder(const fs::path& from, const fs::path& to) {
@@ -47,20 +35,14 @@ void linkFolder(const fs::path& from, const fs::path& to) {
 int runRenderStudy(const fs::path& scenePath, const fs::path& dir, const std::vector<std::string>& baseOverrides,
                    std::vector<StudyRun>& runs, const std::vector<std::vector<std::string>>& runOverrides,
                    int threads, Progress& progress) {
-  std::vector<std::string> threadArgs;
-  if (threads > 0) threadArgs = {"--threads", std::to_string(threads)};
-  const auto withThreads = [&](std::vector<std::string> args) {
-    args.insert(args.end(), threadArgs.begin(), threadArgs.end());
-    return args;
-  };
   // The base: simulated and surfaced once.
   StudyRun base;
   base.folder = dir / "base";
-  std::vector<std::string> simArgs = withThreads({"surge", "sim", scenePath.string(), "--quiet", "--out",
-                                                  base.folder.string()});
+  std::vector<std::string> simArgs = {"surge", "sim", scenePath.string(), "--quiet", "--out", base.folder.string()};
   for (const std::string& assignment : baseOverrides) simArgs.insert(simArgs.end(), {"--set", assignment});
-  for (const auto& args : {simArgs, withThreads({"surge", "surface", base.folder.string(), "--quiet"})}) {
-    runChild(base, args);
+  const std::vector<std::string> surfaceArgs = {"surge", "surface", base.folder.string(), "--quiet"};
+  for (const auto& args : {simArgs, surfaceArgs}) {
+    runChild(base, args, threads);
     if (base.status != "ok")
       throw RunError("study: the " + args[1] + " stage for the renders failed (" + base.message + "), see " +
                      (base.folder / "log.txt").string());
@@ -73,9 +55,9 @@ int runRenderStudy(const fs::path& scenePath, const fs::path& dir, const std::ve
     fs::create_directories(run.folder);
     fs::copy_file(base.folder / "scene.json", run.folder / "scene.json", fs::copy_options::overwrite_existing);
     for (const char* stage : {"surface", "colliders"}) linkFolder(base.folder / stage, run.folder / stage);
-    std::vector<std::string> args = withThreads({"surge", "render", run.folder.string(), "--quiet"});
+    std::vector<std::string> args = {"surge", "render", run.folder.string(), "--quiet"};
     for (const std::string& assignment : runOverrides[i]) args.insert(args.end(), {"--set", assignment});
-    runChild(run, args);
+    runChild(run, args, threads);
     run.framesDone = int(listFrames(run.folder, "frames", "png").size());
     writeRunRecord(run);
     progress.advance();
@@ -95,16 +77,23 @@ int runRenderStudy(const fs::path& scenePath, const fs::path& dir, const std::ve
   };
   for (size_t i = 0; i < runs.size(); ++i)
     if (runs[i].status == "ok" && better(i)) reference = int(i);
+  // The reference's frames, decoded once.
+  std::vector<int> frames;
+  std::vector<Image> referenceFrames;
+  if (reference >= 0) {
+    frames = listFrames(runs[reference].folder, "frames", "png");
+    for (int f : frames) referenceFrames.push_back(readPng(framePath(runs[reference].folder, "frames", f, "png")));
+  }
   for (StudyRun& run : runs) {
     run.error = run.fieldError = run.frontRms = run.heightRms = run.window = NAN;
     run.reference = reference >= 0 && &run == &runs[reference];
-    if (reference < 0 || run.status != "ok") continue;
-    double sum = 0, count = 0;
-    bool comparable = run.framesDone == runs[reference].framesDone;
-    for (int f : listFrames(run.folder, "frames", "png"))
-      comparable = comparable && squaredDifference(framePath(run.folder, "frames", f, "png"),
-                                                   framePath(runs[reference].folder, "frames", f, "png"), sum, count);
-    if (comparable && count > 0) run.error = std::sqrt(sum / count);
+    if (reference < 0 || run.status != "ok" || frames.empty() || listFrames(run.folder, "frames", "png") != frames)
+      continue;
+    // Every frame has the same size: the mean of the frames' mean squares is the mean square over them all.
+    double sum = 0;
+    for (size_t k = 0; k < frames.size(); ++k)
+      sum += meanSquaredDifference(readPng(framePath(run.folder, "frames", frames[k], "png")), referenceFrames[k]);
+    run.error = std::sqrt(sum / double(frames.size()));  // NaN if the sizes differ
   }
   return reference;
 }

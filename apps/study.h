@@ -46,10 +46,10 @@ struct StudyRun {
   double frontRms = 0, heightRms = 0, fieldError = 0, error = 0;
 };
 
-// Runs `args` (args[0] "surge", args[1] its command) as a child surge process with stdout and stderr into
-// run.folder/log.txt, and fills the run's status, message (its last line when it failed), CPU and wall seconds
+// Runs `args` (args[0] "surge", args[1] its command; `--threads` added when threads > 0) as a child surge
+// process with stdout and stderr into run.folder/log.txt, and fills the run's status, message (its last line when it failed), CPU and wall seconds
 // (wait4: all its threads) and peak memory. Throws Interrupted if the child was interrupted.
-void runChild(StudyRun& run, std::vector<std::string> args);
+void runChild(StudyRun& run, std::vector<std::string> args, int threads);
 
 // A study of render settings (every swept key render.*, apps/render_study.cpp): the scene simulated and
 // surfaced once into dir/base (`baseOverrides` applied), then each run renders those surfaces with its own

@@ -92,7 +92,8 @@ std::string lastLine(const fs::path& path) {
 
 }  // namespace
 
-void runChild(StudyRun& run, std::vector<std::string> args) {
+void runChild(StudyRun& run, std::vector<std::string> args, int threads) {
+  if (threads > 0) args.insert(args.end(), {"--threads", std::to_string(threads)});
   fs::create_directories(run.folder);
   const std::string log = (run.folder / "log.txt").string();
   std::vector<char*> argv;
@@ -134,9 +135,8 @@ namespace {
 // Runs `surge sim` for one combination with stdout and stderr into the run folder's log.txt, and measures it.
 void runOne(StudyRun& run, const std::string& scenePath, const std::vector<std::string>& overrides, int threads) {
   std::vector<std::string> args = {"surge", "sim", scenePath, "--quiet", "--out", run.folder.string()};
-  if (threads > 0) args.insert(args.end(), {"--threads", std::to_string(threads)});
   for (const std::string& assignment : overrides) args.insert(args.end(), {"--set", assignment});
-  runChild(run, args);
+  runChild(run, args, threads);
   readRunStats(run);
 }
 
@@ -254,42 +254,34 @@ void addStudyCommand(CLI::App& app) {
       writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << sceneToJson(scene); });
     const auto start = std::chrono::steady_clock::now();
     TerminalProgress progress(!common.quiet);
+    int reference = -1;
+    std::string errorLabel;
     if (renderStudy) {
       std::vector<std::vector<std::string>> renderOverrides;
       for (const std::vector<std::string>& assignments : overrides)
         renderOverrides.emplace_back(assignments.end() - sweeps.size(), assignments.end());
-      const int reference = runRenderStudy(options->scene, dir, base, runs, renderOverrides, common.threads, progress);
-      writeStudyCsv(dir / "study.csv", sweeps, runs);
-      const std::string warning =
-          writeStudyPlots(dir, sweeps, runs, reference, "image RMSE against the reference (8-bit sRGB values)");
-      if (!warning.empty()) std::fprintf(stderr, "surge: warning: %s\n", warning.c_str());
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      char line[512];
-      std::snprintf(line, sizeof line, "study: %zu renders in %.1f s, reference run %d -> %s", runs.size(), seconds,
-                    reference, (dir / "study.csv").string().c_str());
-      say(common, line);
-      return;
-    }
-    progress.start("study", runs.size());
-    for (size_t i = 0; i < runs.size(); ++i) {
-      Progress::checkInterrupt();
-      if (options->report) {
-        readRunRecord(runs[i]);
-        readRunStats(runs[i]);
-      } else {
-        runOne(runs[i], options->scene, overrides[i], common.threads);
-        writeRunRecord(runs[i]);
+      reference = runRenderStudy(options->scene, dir, base, runs, renderOverrides, common.threads, progress);
+      errorLabel = "image RMSE against the reference (8-bit sRGB values)";
+    } else {
+      progress.start("study", runs.size());
+      for (size_t i = 0; i < runs.size(); ++i) {
+        Progress::checkInterrupt();
+        if (options->report) {
+          readRunRecord(runs[i]);
+          readRunStats(runs[i]);
+        } else {
+          runOne(runs[i], options->scene, overrides[i], common.threads);
+          writeRunRecord(runs[i]);
+        }
+        progress.advance();
       }
-      progress.advance();
+      progress.finish();
+      const bool damBreak = isDamBreak(scene);
+      reference = compareWithReference(runs, damBreak, scene.domain, scene.dimensions);
+      errorLabel = damBreak ? "RMS error of front and back height (m)" : "density field error (fraction)";
     }
-    progress.finish();
-
-    const bool damBreak = isDamBreak(scene);
-    const int reference = compareWithReference(runs, damBreak, scene.domain, scene.dimensions);
     writeStudyCsv(dir / "study.csv", sweeps, runs);
-    const std::string warning = writeStudyPlots(
-        dir, sweeps, runs, reference,
-        damBreak ? "RMS error of front and back height (m)" : "density field error (fraction)");
+    const std::string warning = writeStudyPlots(dir, sweeps, runs, reference, errorLabel);
     if (!warning.empty()) std::fprintf(stderr, "surge: warning: %s\n", warning.c_str());
 
     int bad = 0;

@@ -30,21 +30,6 @@ std::vector<int> parseList(const std::string& text, char separator = ',') {
   return values;
 }
 
-// Root mean square difference of the 8-bit values.
-double rmse(const surge::Image& a, const surge::Image& b) {
-  if (a.width != b.width || a.height != b.height) {
-    std::fprintf(stderr, "surge_render_quality: the reference is %dx%d, the image %dx%d\n", b.width, b.height,
-                 a.width, a.height);
-    std::exit(2);
-  }
-  double sum = 0;
-  for (size_t i = 0; i < a.rgb.size(); ++i) {
-    const double d = double(a.rgb[i]) - double(b.rgb[i]);
-    sum += d * d;
-  }
-  return std::sqrt(sum / double(a.rgb.size()));
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -78,7 +63,12 @@ int main(int argc, char** argv) {
       const surge::Image image = tracer.render(meshes[i], {}, scene, frames[i], &stats);
       seconds += surge::secondsSince(start);
       edgeShare += double(stats.edgePixels) / (double(image.width) * image.height) / double(frames.size());
-      const double e = rmse(image, references[i]);
+      const double e = std::sqrt(surge::meanSquaredDifference(image, references[i]));
+      if (std::isnan(e)) {
+        std::fprintf(stderr, "surge_render_quality: frame %d is %dx%d, its reference %dx%d\n", frames[i],
+                     image.width, image.height, references[i].width, references[i].height);
+        return 2;
+      }
       squares += e * e;
       char text[32];
       std::snprintf(text, sizeof text, "%s%.2f", i ? ", " : "", e);

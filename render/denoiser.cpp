@@ -39,16 +39,11 @@ float powerOfTwoPower(float c, int k) {
   return c;
 }
 
-}  // namespace
-
-namespace {
-
 // What a tap compares, packed: the guides, and the light with its variance (and its luminance).
 struct alignas(32) Guide {
   Vec3 normal;
   float depth;
   Vec3 albedo;
-  float unused;
 };
 struct alignas(32) Light {
   Vec3 rgb;
@@ -112,7 +107,7 @@ const std::vector<Vec3>& Denoiser::filter(const std::vector<PixelFeatures>& pixe
     }
     const Vec3 albedo = f.albedo.cwiseMax(kLeastAlbedo);
     const float a = luminance(albedo);
-    guides[p] = {f.normal, f.depth, f.albedo, 0.0f};
+    guides[p] = {f.normal, f.depth, f.albedo};
     const Vec3 rgb = f.colour.cwiseQuotient(albedo);
     light[p] = {rgb, variance / (a * a), luminance(rgb)};
   });

@@ -12,6 +12,16 @@
 
 namespace surge {
 
+double meanSquaredDifference(const Image& a, const Image& b) {
+  if (a.width != b.width || a.height != b.height || a.rgb.size() != b.rgb.size() || a.rgb.empty()) return NAN;
+  double sum = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    const double d = double(a.rgb[i]) - double(b.rgb[i]);
+    sum += d * d;
+  }
+  return sum / double(a.rgb.size());
+}
+
 uint8_t encodeSrgb(float linear) {
   const float c = std::clamp(linear, 0.0f, 1.0f);
   const float encoded = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;

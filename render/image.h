@@ -16,6 +16,10 @@ struct Image {
 // Linear light in [0, 1] (clamped outside) to an 8-bit sRGB value, rounded to nearest.
 uint8_t encodeSrgb(float linear);
 
+// The mean of the squared differences of two images' 8-bit values over every pixel and channel (the square of
+// the RMS image error of docs/performance.md); NaN if their sizes differ.
+double meanSquaredDifference(const Image& a, const Image& b);
+
 // Writes a PNG atomically (the file appears whole or not at all); throws RunError on failure.
 void writePng(const fs::path& path, const Image& image);
 

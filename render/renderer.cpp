@@ -152,29 +152,32 @@ Image traceImage(RenderWorkspace& workspace, const RayDevice& device, const Tria
     });
     edgePixels = uint64_t(std::count(edge.begin(), edge.end(), uint8_t(1)));
   }
-  std::vector<PixelFeatures>& features = workspace.features;
-  features.resize(denoising ? sums.size() : 0);
-  for (size_t pixel = 0; pixel < sums.size(); ++pixel) {
-    const PixelSums& p = sums[pixel];
-    const float n = float(p.taken);
-    const Eigen::Vector3f colour = p.colour / n;
-    if (!denoising) {
+  // Each pixel's mean, filtered when denoising, tone-mapped.
+  const auto toImage = [&](const auto& colourOf) {
+    for (size_t pixel = 0; pixel < sums.size(); ++pixel) {
+      const Eigen::Vector3f colour = colourOf(pixel);
       for (int k = 0; k < 3; ++k) image.rgb[3 * pixel + k] = encodeSrgb(toneMap(colour[k], look.exposure));
-      continue;
     }
-    PixelFeatures& mean = features[pixel];
-    mean.kept = p.kept / n;
-    mean.colour = colour - mean.kept;
-    mean.albedo = p.albedo / n;
-    mean.normal = p.normal / n;
-    mean.depth = p.depth / n;
-    mean.luminanceSquare = p.luminanceSquare / n;
-    mean.samples = p.taken;
-  }
-  if (denoising) {
+  };
+  if (!denoising) {
+    toImage([&](size_t pixel) { return Eigen::Vector3f(sums[pixel].colour / float(sums[pixel].taken)); });
+  } else {
+    std::vector<PixelFeatures>& features = workspace.features;
+    features.resize(sums.size());
+    for (size_t pixel = 0; pixel < sums.size(); ++pixel) {
+      const PixelSums& p = sums[pixel];
+      const float n = float(p.taken);
+      PixelFeatures& mean = features[pixel];
+      mean.kept = p.kept / n;
+      mean.colour = p.colour / n - mean.kept;
+      mean.albedo = p.albedo / n;
+      mean.normal = p.normal / n;
+      mean.depth = p.depth / n;
+      mean.luminanceSquare = p.luminanceSquare / n;
+      mean.samples = p.taken;
+    }
     const std::vector<Eigen::Vector3f>& filtered = workspace.denoiser.filter(features, width, height);
-    for (size_t pixel = 0; pixel < filtered.size(); ++pixel)
-      for (int k = 0; k < 3; ++k) image.rgb[3 * pixel + k] = encodeSrgb(toneMap(filtered[pixel][k], look.exposure));
+    toImage([&](size_t pixel) { return filtered[pixel]; });
   }
   if (stats) {
     stats->rays += rays.load();

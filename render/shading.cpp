@@ -151,6 +151,14 @@ bool waterEvent(const Shading& shading, const Vec3& normal, const Hit& hit, bool
   return true;
 }
 
+// waterEvent at a hit with its smooth normal, or with the face's where the smooth normal disagrees with the
+// face (a ray grazing a coarse mesh); false if neither gives a consistent event.
+bool waterEventAt(const Shading& shading, const Hit& hit, bool inside, const Vec3& d, float& fresnel,
+                  Vec3& reflected, Vec3& refracted) {
+  if (waterEvent(shading, hit.normal, hit, inside, d, fresnel, reflected, refracted)) return true;
+  return waterEvent(shading, hit.geometricNormal, hit, inside, d, fresnel, reflected, refracted);
+}
+
 Vec3 sunDisc(const Shading& shading, const Vec3& direction) {
   if (direction.dot(shading.sunDirection) < shading.sunCosRadius) return Vec3::Zero();
   // Radiance that gives irradiance pi * sunColor over the disc's solid angle 2 pi (1 - cos r).
@@ -209,6 +217,14 @@ Vec3 groundAlbedoAt(const Shading& shading, const Vec3& p, float distance) {
 
 namespace {
 
+// The albedo of a diffuse hit (the ground's checkerboard at the distance travelled to it, a collider's colour,
+// the tank's edges).
+Vec3 diffuseAlbedo(const Shading& shading, const Hit& hit, float travelled) {
+  return hit.kind == SurfaceKind::Ground     ? groundAlbedoAt(shading, hit.point, travelled)
+         : hit.kind == SurfaceKind::Collider ? hit.albedo
+                                             : Vec3::Constant(shading.tankAlbedo);
+}
+
 // Where a path is: its next ray, whether it is in water, whether it has been specular so far (then the sun's
 // disc is seen, not sampled), how far the camera ray and its specular continuations went (checker fade), its
 // segment count, its throughput, and whether it may still split at water or at how many glass walls (see
@@ -246,9 +262,7 @@ struct GuideChain {
       firstSeen = true;
     }
     if (hit.kind == SurfaceKind::Water) return true;
-    features->albedo = hit.kind == SurfaceKind::Ground     ? groundAlbedoAt(shading, hit.point, travelled)
-                       : hit.kind == SurfaceKind::Collider ? hit.albedo
-                                                           : Vec3::Constant(shading.tankAlbedo);
+    features->albedo = diffuseAlbedo(shading, hit, travelled);
     return finish();
   }
   bool finish() {
@@ -275,13 +289,9 @@ void continueChain(const RayScene& world, const Shading& shading, Ray ray, bool 
     }
     float fresnel = 1;
     Vec3 reflected, refracted;
-    Hit face = hit;
-    if (!waterEvent(shading, hit.normal, hit, inside, ray.direction, fresnel, reflected, refracted)) {
-      face.normal = hit.geometricNormal;
-      if (!waterEvent(shading, face.normal, face, inside, ray.direction, fresnel, reflected, refracted)) {
-        chain.finish();
-        return;
-      }
+    if (!waterEventAt(shading, hit, inside, ray.direction, fresnel, reflected, refracted)) {
+      chain.finish();
+      return;
     }
     if (fresnel < 1.0f) {
       ray.origin = hit.passPoint;
@@ -334,14 +344,9 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
     if (hit.kind == SurfaceKind::Water) {
       float fresnel = 1;
       Vec3 reflected, refracted;
-      Hit face = hit;
-      if (!waterEvent(shading, hit.normal, hit, path.inside, ray.direction, fresnel, reflected, refracted)) {
-        face.normal = hit.geometricNormal;  // the smooth normal disagrees with the face here
-        if (!waterEvent(shading, face.normal, face, path.inside, ray.direction, fresnel, reflected,
-                        refracted)) {
-          if (path.onChain) chain->finish();
-          return radiance;
-        }
+      if (!waterEventAt(shading, hit, path.inside, ray.direction, fresnel, reflected, refracted)) {
+        if (path.onChain) chain->finish();
+        return radiance;
       }
       if (path.splitWater && fresnel < 1.0f) {
         PathState mirror = path, through = path;
@@ -403,9 +408,7 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
         continue;
       }
     } else {
-      const Vec3 albedo = hit.kind == SurfaceKind::Ground ? groundAlbedoAt(shading, hit.point, path.travelled)
-                          : hit.kind == SurfaceKind::Collider ? hit.albedo
-                                                              : Vec3::Constant(shading.tankAlbedo);
+      const Vec3 albedo = diffuseAlbedo(shading, hit, path.travelled);
       // Next-event estimation of the sun: (albedo / pi) L_sun cos / pdf, with pdf = 1 / solid angle of the
       // disc, which is albedo * sunColor * cos.
       const Vec3 toSun = sampleSun(shading, random);
