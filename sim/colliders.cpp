@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "geometry/pose.h"
 
 namespace surge {
@@ -320,9 +321,40 @@ size_t removeParticlesInside(const Colliders<Dim>& colliders, ParticleFrame& fra
   return removed;
 }
 
+template <int Dim>
+void driftAgainstSolids(std::vector<Vec<Dim>>& x, std::vector<Vec<Dim>>& v, float dt, float mass,
+                        Colliders<Dim>& colliders, const TankWalls<Dim>& walls) {
+  parallelFor(0, x.size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const Vec<Dim> from = x[i];
+      x[i] += dt * v[i];
+      if (!colliders.empty()) {
+        colliders.project(from, x[i], true, [&](size_t c, const Vec<Dim>& delta) {
+          const float length = delta.norm();
+          if (!(length > 0)) return;
+          const Vec<Dim> n = delta / length;
+          const float approach = (v[i] - colliders.wallVelocity(c, x[i])).dot(n);
+          if (approach >= 0) return;
+          const Vec<Dim> change = -approach * n;
+          v[i] += change;
+          colliders.addImpulse(i, c, mass * change, x[i]);
+        });
+        if (colliders.hasFriction()) colliders.applyFriction(i, x[i], v[i], mass);
+      }
+      const int moved = walls.clamp(x[i]);
+      for (int k = 0; k < Dim; ++k)
+        if (moved & (1 << k)) v[i][k] = 0;
+    }
+  });
+}
+
 template class Colliders<2>;
 template class Colliders<3>;
 template size_t removeParticlesInside(const Colliders<2>&, ParticleFrame&);
 template size_t removeParticlesInside(const Colliders<3>&, ParticleFrame&);
+template void driftAgainstSolids(std::vector<Vec<2>>&, std::vector<Vec<2>>&, float, float, Colliders<2>&,
+                                 const TankWalls<2>&);
+template void driftAgainstSolids(std::vector<Vec<3>>&, std::vector<Vec<3>>&, float, float, Colliders<3>&,
+                                 const TankWalls<3>&);
 
 }  // namespace surge

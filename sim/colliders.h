@@ -100,12 +100,7 @@ class Colliders {
   // sum_b (g . (x_b - x_i)) grad W(x_i - x_b) over the flat wall at d along n; the wall's push on the particle
   // gains -m / rho_i times it. Mirroring p_i alone (p_b = p_i) pushes too hard on a particle below a wall and
   // too softly above one: a ball under water read 27% over Archimedes in 3D (docs/colliders.md).
-  VecD hydrostaticSum(float d, const VecD& n, const VecD& g) const {
-    float normal, tangent;
-    tank_->flatWall().moments(d, normal, tangent);
-    const float gn = g.dot(n);
-    return -(gn * normal) * n - tangent * (g - gn * n);
-  }
+  VecD hydrostaticSum(float d, const VecD& n, const VecD& g) const { return tank_->flatWall().hydrostaticSum(d, n, g); }
 
   // Adds every collider's share of the density sums at p (as TankWalls::add does for the tank).
   void add(const VecD& p, float& weight, VecD& gradient) const {
@@ -236,6 +231,14 @@ class Colliders {
 // fluid box drawn against a wall keeps its layer a radius from it.
 template <int Dim>
 size_t removeParticlesInside(const Colliders<Dim>& colliders, ParticleFrame& frame);
+
+// Moves every particle by dt v (x += dt v), stopped at the colliders and the tank: the collision
+// response. A particle stopped at a collider loses its velocity into it, relative to the wall's own, and that
+// change is the collider's impulse; friction acts on the particles touching one; at a tank wall the particle is
+// clamped a radius inside and loses its velocity into that wall.
+template <int Dim>
+void driftAgainstSolids(std::vector<Vec<Dim>>& x, std::vector<Vec<Dim>>& v, float dt, float mass,
+                        Colliders<Dim>& colliders, const TankWalls<Dim>& walls);
 
 // The tank and the colliders together, as the measures see them.
 template <int Dim>

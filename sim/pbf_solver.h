@@ -20,6 +20,7 @@
 #include "core/scene.h"
 #include "sim/attractor.h"
 #include "sim/colliders.h"
+#include "sim/fluid_solver.h"
 #include "sim/kernels.h"
 #include "sim/measures.h"
 #include "sim/neighbor_grid.h"
@@ -28,7 +29,7 @@
 namespace surge {
 
 template <int Dim>
-class PbfSolver {
+class PbfSolver final : public FluidSolver<Dim> {
  public:
   using VecD = Vec<Dim>;
 
@@ -39,31 +40,28 @@ class PbfSolver {
   PbfSolver(const PbfSolver&) = delete;
   PbfSolver& operator=(const PbfSolver&) = delete;
 
-  void setParticles(const ParticleFrame& frame);
-  void getParticles(ParticleFrame& frame) const;
-  size_t size() const { return x_.size(); }
+  void setParticles(const ParticleFrame& frame) override;
+  void getParticles(ParticleFrame& frame) const override;
+  size_t size() const override { return x_.size(); }
 
   // The frame loop's interface (see sim/simulation.cpp): PBF takes the scene's substeps a frame.
-  int fixedSubsteps() const { return substeps_; }
-  void beginFrame(double) {}
-  float stableTimeStep() const { return INFINITY; }
-  float maxPressure() const { return NAN; }  // PBF has no pressure
+  int fixedSubsteps() const override { return substeps_; }
+  void beginFrame(double) override {}
+  float stableTimeStep() override { return INFINITY; }
 
   // One time step of Algorithm 1 from `time` (which moves the attractor). Returns the index of the first
   // particle whose state is not finite or lies outside the domain afterwards, or -1 if all are well.
-  long step(float dt, double time = 0);
+  long step(float dt, double time = 0) override;
 
-  FluidMeasures measure();
-  int lastIterations() const { return lastIterations_; }
-  PhaseTimes& phaseTimes() { return times_; }
+  FluidMeasures measure() override;
+  int lastIterations() const override { return lastIterations_; }
+  PhaseTimes& phaseTimes() override { return times_; }
   uint32_t particleId(size_t i) const { return id_[i]; }
-  float particleMass() const { return mass_; }
-  const std::vector<VecD>& positions() const { return x_; }
-  const std::vector<VecD>& velocities() const { return v_; }
-  // Each collider's mean force and torque from the fluid since the last call, over `duration` seconds.
-  std::vector<Wrench> takeColliderWrenches(double duration) { return colliders_.takeFrameWrenches(duration); }
+  float particleMass() const override { return mass_; }
+  const std::vector<VecD>& positions() const override { return x_; }
+  const std::vector<VecD>& velocities() const override { return v_; }
   const Colliders<Dim>& colliders() const { return colliders_; }
-  Colliders<Dim>& colliders() { return colliders_; }  // the bodies' coupling sets their poses here
+  Colliders<Dim>& colliders() override { return colliders_; }
   // Bytes held by every particle channel, the grid, the neighbour lists and the pair factors (capacities).
   size_t memoryBytes() const;
 

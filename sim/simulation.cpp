@@ -14,9 +14,8 @@
 
 #include "core/errors.h"
 #include "geometry/pose.h"
-#include "sim/pbf_solver.h"
+#include "sim/fluid_solver.h"
 #include "sim/rigid_bodies.h"
-#include "sim/wcsph_solver.h"
 
 namespace surge {
 namespace {
@@ -206,10 +205,10 @@ void writeBodyFrame(const Scene& scene, const ColliderShapes& shapes, const Rigi
   writeBodyStates(framePath(dir, "bodies", frame, "txt"), scene, bodies.states());
 }
 
-// The frame loop, for either solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
+// The frame loop, for any solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
 // otherwise each step is the largest stable one (stableTimeStep) shortened so the steps left end exactly on the
 // frame: dt = remaining / ceil(remaining / stable).
-template <int Dim, typename Solver>
+template <int Dim>
 SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
                       bool resume, Progress& progress) {
   const auto runStart = std::chrono::steady_clock::now();
@@ -217,7 +216,8 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
   removeStaleFiles(particleDir, !resume);
   fs::create_directories(particleDir);
 
-  Solver solver(scene, shapes);
+  const std::unique_ptr<FluidSolver<Dim>> method = makeFluidSolver<Dim>(scene, shapes);
+  FluidSolver<Dim>& solver = *method;
   SimulationSummary summary;
   const bool colliding = !scene.colliders.empty();
   if (colliding) writeColliderMeshes(scene, *shapes, dir, resume);
@@ -405,12 +405,8 @@ SimulationSummary simulate(const Scene& scene, const fs::path& dir, bool resume,
 
 SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
                            bool resume, Progress& progress) {
-  const bool wcsph = scene.solver.method == "wcsph";
-  if (scene.dimensions == 2)
-    return wcsph ? run<2, WcsphSolver<2>>(scene, shapes, dir, resume, progress)
-                 : run<2, PbfSolver<2>>(scene, shapes, dir, resume, progress);
-  return wcsph ? run<3, WcsphSolver<3>>(scene, shapes, dir, resume, progress)
-               : run<3, PbfSolver<3>>(scene, shapes, dir, resume, progress);
+  return scene.dimensions == 2 ? run<2>(scene, shapes, dir, resume, progress)
+                               : run<3>(scene, shapes, dir, resume, progress);
 }
 
 const char* collidersCsvHeader() { return "frame,collider,fx,fy,fz,tx,ty,tz"; }

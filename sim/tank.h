@@ -57,6 +57,15 @@ struct FlatWallTable {
     normal = at(normalMoment, d);
     tangent = at(tangentMoment, d);
   }
+  // sum_b (g . (x_b - x_i)) grad W(x_i - x_b) over the wall's lattice at d along its normal n (pointing from the
+  // wall to the particle): the hydrostatic continuation of pressure into the wall (Colliders::hydrostaticSum).
+  template <typename VecD>
+  VecD hydrostaticSum(float d, const VecD& n, const VecD& g) const {
+    float normal, tangent;
+    moments(d, normal, tangent);
+    const float gn = g.dot(n);
+    return -(gn * normal) * n - tangent * (g - gn * n);
+  }
 
  private:
   float at(const std::vector<float>& table, float d) const {

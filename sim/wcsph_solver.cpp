@@ -15,21 +15,6 @@ double millisecondsSince(Clock::time_point start) {
 }
 
 
-// The tank's walls seen through the scene's kernel.
-template <int Dim>
-TankWalls<Dim> makeWalls(const Scene& scene) {
-  const float support = static_cast<float>(scene.solver.kernel_radius);
-  const float spacing = static_cast<float>(scene.particle_spacing);
-  const Vec<Dim> lo = toVec<Dim>(scene.domain.min), hi = toVec<Dim>(scene.domain.max);
-  auto build = [&](const auto& kernel) {
-    return TankWalls<Dim>(
-        lo, hi, spacing, support, [&](const Vec<Dim>& r) { return kernel.value(r.norm()); },
-        [&](const Vec<Dim>& r) -> Vec<Dim> { return kernel.gradientFactor(r.norm()) * r; });
-  };
-  if (scene.solver.kernel == "wendland_c2") return build(WendlandC2Kernel<Dim>(support));
-  return build(CubicSplineKernel<Dim>(support));
-}
-
 }  // namespace
 
 template <int Dim>
@@ -42,7 +27,7 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const Collider
       attractor_(scene.attractor),
       grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
             static_cast<float>(0.5 * scene.solver.kernel_radius)),
-      walls_(makeWalls<Dim>(scene)) {
+      walls_(makeSphTankWalls<Dim>(scene)) {
   if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
   sceneSpeedLimit_ = static_cast<float>(runawaySpeed(scene));
   const SolverSettings& s = scene.solver;
@@ -50,15 +35,7 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const Collider
   smoothingLength_ = 0.5f * support_;
   restDensity_ = static_cast<float>(s.rest_density);
   // The mass gives the rest lattice exactly rho_0 (the same choice as PBF's, with this kernel).
-  double weightSum = 0, unused = 0;
-  const float spacing = static_cast<float>(scene.particle_spacing);
-  auto sums = [&](const auto& kernel) {
-    latticeSums<Dim>(spacing, support_, [&](const VecD& r) { return kernel.value(r.norm()); },
-                     [&](const VecD& r) -> VecD { return kernel.gradientFactor(r.norm()) * r; }, &weightSum, &unused);
-  };
-  if (wendland_) sums(wendland_kernel_);
-  else sums(cubic_);
-  mass_ = static_cast<float>(s.rest_density / weightSum);
+  mass_ = sphParticleMass<Dim>(scene);
   speedOfSound_ = static_cast<float>(s.speed_of_sound);
   gasConstant_ = static_cast<float>(s.gas_constant);
   taitB_ = restDensity_ * speedOfSound_ * speedOfSound_ / 7.0f;
@@ -129,33 +106,6 @@ float WcsphSolver<Dim>::stableTimeStep() {
 }
 
 template <int Dim>
-void WcsphSolver<Dim>::drift(float dt) {
-  parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      const VecD from = x_[i];
-      x_[i] += dt * v_[i];
-      if (!colliders_.empty()) {
-        // Stopped at a collider: no velocity into it, relative to its own; the change is the collider's impulse.
-        colliders_.project(from, x_[i], true, [&](size_t c, const VecD& delta) {
-          const float length = delta.norm();
-          if (!(length > 0)) return;
-          const VecD n = delta / length;
-          const float approach = (v_[i] - colliders_.wallVelocity(c, x_[i])).dot(n);
-          if (approach >= 0) return;
-          const VecD change = -approach * n;
-          v_[i] += change;
-          colliders_.addImpulse(i, c, mass_ * change, x_[i]);
-        });
-        if (colliders_.hasFriction()) colliders_.applyFriction(i, x_[i], v_[i], mass_);
-      }
-      const int moved = walls_.clamp(x_[i]);
-      for (int k = 0; k < Dim; ++k)
-        if (moved & (1 << k)) v_[i][k] = 0;  // no velocity into a wall the particle was stopped at
-    }
-  });
-}
-
-template <int Dim>
 long WcsphSolver<Dim>::step(float dt, double time) {
   if (!colliders_.empty()) colliders_.beginStep(time, dt);
   if (!accelerationsValid_) computeAccelerations(time);
@@ -167,7 +117,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
       for (size_t i = b; i < e; ++i) v_[i] += (0.5f * dt) * a_[i];
     });
     if (colliding) colliders_.addWrenches(colliderForces_, 0.5 * dt);
-    drift(dt);
+    driftAgainstSolids(x_, v_, dt, mass_, colliders_, walls_);
     if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
     computeAccelerations(time + dt);
     parallelFor(0, size(), [&](size_t b, size_t e) {
@@ -181,7 +131,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
       for (size_t i = b; i < e; ++i) v_[i] += dt * a_[i];
     });
     if (colliding) colliders_.addWrenches(colliderForces_, dt);
-    drift(dt);
+    driftAgainstSolids(x_, v_, dt, mass_, colliders_, walls_);
     if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
     accelerationsValid_ = false;
   }

@@ -22,6 +22,7 @@
 #include "core/scene.h"
 #include "sim/attractor.h"
 #include "sim/colliders.h"
+#include "sim/fluid_solver.h"
 #include "sim/kernels.h"
 #include "sim/neighbor_grid.h"
 #include "sim/measures.h"
@@ -30,7 +31,7 @@
 namespace surge {
 
 template <int Dim>
-class WcsphSolver {
+class WcsphSolver final : public FluidSolver<Dim> {
  public:
   using VecD = Vec<Dim>;
 
@@ -41,31 +42,29 @@ class WcsphSolver {
   WcsphSolver(const WcsphSolver&) = delete;
   WcsphSolver& operator=(const WcsphSolver&) = delete;
 
-  void setParticles(const ParticleFrame& frame);
-  void getParticles(ParticleFrame& frame) const;
-  size_t size() const { return x_.size(); }
+  void setParticles(const ParticleFrame& frame) override;
+  void getParticles(ParticleFrame& frame) const override;
+  size_t size() const override { return x_.size(); }
 
   // Steps are chosen by the solver (stableTimeStep), not a fixed count per frame.
-  int fixedSubsteps() const { return 0; }
+  int fixedSubsteps() const override { return 0; }
   // Start of an output frame at `time`: forget the stored accelerations (see the header comment).
-  void beginFrame(double time);
+  void beginFrame(double time) override;
   // The largest stable step for the current state (or the scene's fixed time_step).
-  float stableTimeStep();
+  float stableTimeStep() override;
   // One step of dt from `time`. Returns the index of the first particle that is not finite or left the tank, or -1.
-  long step(float dt, double time);
+  long step(float dt, double time) override;
 
-  FluidMeasures measure();
-  float maxPressure() const { return framePressureMax_; }
-  int lastIterations() const { return 0; }
-  PhaseTimes& phaseTimes() { return times_; }
-  float particleMass() const { return mass_; }
+  FluidMeasures measure() override;
+  float maxPressure() const override { return framePressureMax_; }
+  int lastIterations() const override { return 0; }
+  PhaseTimes& phaseTimes() override { return times_; }
+  float particleMass() const override { return mass_; }
   float speedOfSound() const { return speedOfSound_; }
-  const std::vector<VecD>& positions() const { return x_; }
-  const std::vector<VecD>& velocities() const { return v_; }
-  // Each collider's mean force and torque from the fluid since the last call, over `duration` seconds.
-  std::vector<Wrench> takeColliderWrenches(double duration) { return colliders_.takeFrameWrenches(duration); }
+  const std::vector<VecD>& positions() const override { return x_; }
+  const std::vector<VecD>& velocities() const override { return v_; }
   const Colliders<Dim>& colliders() const { return colliders_; }
-  Colliders<Dim>& colliders() { return colliders_; }  // the bodies' coupling sets their poses here
+  Colliders<Dim>& colliders() override { return colliders_; }
   // Pressures of the last evaluation, in the particles' current order (for tests).
   const std::vector<float>& pressures() const { return pressure_; }
 
@@ -73,7 +72,6 @@ class WcsphSolver {
   void computeAccelerations(double time);
   template <typename Kernel>
   void computeAccelerationsWith(const Kernel& kernel, double time);
-  void drift(float dt);
 
   // Parameters.
   bool wendland_, verlet_, tait_;

@@ -1,0 +1,68 @@
+// The one interface every fluid method implements, and the registry that makes the scene's method.
+//
+// The frame loop (sim/simulation.cpp), the rigid bodies' coupling (sim/rigid_bodies.h) and the benchmarks see a
+// solver only through FluidSolver<Dim>. A method is a pair of files (its class deriving from FluidSolver) and one
+// line in the registry (sim/fluid_solver.cpp); its scene keys are declared with the others in
+// core/scene_fields.cpp, and `solver.method`'s choices there must match fluidSolverMethods() (a test checks).
+// A method allocates only what its scene turns on, so a scene pays only for what its method uses.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/ply.h"
+#include "core/scene.h"
+#include "sim/colliders.h"
+#include "sim/measures.h"
+
+namespace surge {
+
+template <int Dim>
+class FluidSolver {
+ public:
+  virtual ~FluidSolver() = default;
+
+  virtual void setParticles(const ParticleFrame& frame) = 0;
+  virtual void getParticles(ParticleFrame& frame) const = 0;
+  virtual size_t size() const = 0;
+  // The particles in the solver's current order (it reorders them by grid cell), and their mass.
+  virtual const std::vector<Vec<Dim>>& positions() const = 0;
+  virtual const std::vector<Vec<Dim>>& velocities() const = 0;
+  virtual float particleMass() const = 0;
+
+  // Steps a frame: > 0 for a method that takes that many equal steps; 0 for one that chooses each step's
+  // length (stableTimeStep, read before every step).
+  virtual int fixedSubsteps() const = 0;
+  virtual float stableTimeStep() = 0;
+  // The start of an output frame at `time`. A method that carries state between steps beyond positions and
+  // velocities (stored accelerations, warm starts) forgets it here, so that a run resumed from a frame file
+  // continues exactly as an uninterrupted one.
+  virtual void beginFrame(double time) = 0;
+  // One step of dt from `time`. Returns the index of the first particle that is not finite, left the tank or
+  // ran away (firstParticleOutside), or -1 if all are well.
+  virtual long step(float dt, double time) = 0;
+
+  // What stats.csv reports: the measures of the current state, the last step's solver iterations, the largest
+  // pressure this frame (NaN for a method without pressures) and the time spent per phase.
+  virtual FluidMeasures measure() = 0;
+  virtual int lastIterations() const = 0;
+  virtual float maxPressure() const { return NAN; }
+  virtual PhaseTimes& phaseTimes() = 0;
+
+  // The colliders and bodies the fluid meets (empty without them); the bodies' coupling sets their poses.
+  virtual Colliders<Dim>& colliders() = 0;
+  // Each collider's mean force and torque from the fluid since the last call, over `duration` seconds.
+  std::vector<Wrench> takeColliderWrenches(double duration) { return colliders().takeFrameWrenches(duration); }
+};
+
+// The solver of scene.solver.method. `shapes`: the scene's collider shapes, built once by the caller (null
+// builds them). InputError if the method is not registered.
+template <int Dim>
+std::unique_ptr<FluidSolver<Dim>> makeFluidSolver(const Scene& scene,
+                                                  std::shared_ptr<const ColliderShapes> shapes = nullptr);
+
+// The registered methods, in registration order.
+std::vector<std::string> fluidSolverMethods();
+
+}  // namespace surge
