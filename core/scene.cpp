@@ -453,6 +453,7 @@ void validate(Scene& s, const std::string& where) {
 
   SolverSettings& solver = s.solver;
   if (solver.substeps == 0) solver.substeps = std::max(4, stableSubsteps(s));
+  if (solver.method == "dfsph" && solver.max_density_error == 0) solver.max_density_error = 0.0005;
   if (solver.kernel_radius == 0) solver.kernel_radius = 2 * spacing;
   if (solver.kernel_radius <= spacing)
     throw InputError(where, "solver.kernel_radius", "must exceed particle_spacing, or particles have no neighbours");
@@ -524,11 +525,14 @@ size_t Scene::particleCount() const {
   return total;
 }
 
-size_t bytesPerParticleEstimate(int dimensions) {
-  // Measured peaks of the hungrier solver, PBF (the extremes tests and bench/sim_bench.cpp): in 3D about 340
-  // bytes of solver arrays (positions, velocities, predictions and their scratch copy 4 x 12; ids, lambdas and
-  // the grid's 16; about 30 neighbours and their stored gradient factors at 4 bytes each, with slack, 280), the
-  // 28-byte frame being written, and room for the allocator: 400. In 2D, 13 neighbours instead of 30: 250.
+size_t bytesPerParticleEstimate(int dimensions, const std::string& method) {
+  // PBF (the extremes tests and bench/sim_bench.cpp; WCSPH needs less): in 3D about 340 bytes of solver arrays
+  // (positions, velocities, predictions and their scratch copy 4 x 12; ids, lambdas and the grid's 16; about 30
+  // neighbours and their stored gradient factors at 4 bytes each, with slack, 280), the 28-byte frame being
+  // written, and room for the allocator: 400. In 2D, 13 neighbours instead of 30: 250.
+  // DFSPH stores a gradient vector per pair instead of a factor (30 x 8 bytes more in 3D, 13 x 4 in 2D) and
+  // five more floats and a vector a particle: 640 and 320.
+  if (method == "dfsph") return dimensions == 3 ? 640 : 320;
   return dimensions == 3 ? 400 : 250;
 }
 
@@ -663,7 +667,7 @@ MemoryLimit memoryLimit() {
 
 void checkSimulationMemory(const Scene& scene) {
   const size_t count = scene.particleCount();
-  const double bytes = double(count) * double(bytesPerParticleEstimate(scene.dimensions));
+  const double bytes = double(count) * double(bytesPerParticleEstimate(scene.dimensions, scene.solver.method));
   const MemoryLimit memory = memoryLimit();
   if (count > (size_t(1) << 31) || bytes > 0.8 * memory.bytes)
     throw InputError(scene.source, "particle_spacing",

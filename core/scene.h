@@ -29,13 +29,15 @@ struct SolverSettings {
   double kernel_radius = 0;  // 0 in the file: 2 x particle_spacing (resolved on load)
   double rest_density = 1000;
   double relaxation_epsilon = 0.01;
-  double max_density_error = 0;  // > 0: iterate until the average density error is under it
+  double max_density_error = 0;  // > 0: iterate until the average density error is under it (DFSPH: 0 means 0.0005)
+  double max_divergence_error = 0.001;  // DFSPH's divergence solver: average density change a step would cause
+  int max_iterations = 100;             // DFSPH: the most iterations of each of its solvers a step
   double scorr_k = 0.1;          // artificial pressure (PBF eq. 13-14); 0 turns it off
   int scorr_n = 4;
   double scorr_delta_q = 0.2;  // as a fraction of the kernel radius
   double vorticity_epsilon = 0;  // vorticity confinement (eq. 15-16); 0 turns it off
   double xsph_c = 0.01;          // XSPH viscosity (eq. 17); 0 turns it off
-  // Weakly compressible SPH (solver.method "wcsph"); see sim/wcsph_solver.h.
+  // Weakly compressible SPH (solver.method "wcsph", sim/wcsph_solver.h); kernel, cfl and time_step also DFSPH's.
   std::string kernel = "cubic_spline";   // or "wendland_c2"
   std::string equation_of_state = "tait";  // or "linear" (the gas law k (rho - rho_0))
   double speed_of_sound = 0;             // 0 in the file: 10 x the speed of a fall through the tank (resolved)
@@ -226,8 +228,8 @@ fs::path writeStageSettings(const fs::path& dir, const std::string& stage, const
 // A markdown table of every key: path, type, default, allowed values, meaning.
 std::string sceneKeysMarkdown();
 
-// Bytes the simulator needs per particle at peak, for the memory check and for reporting.
-size_t bytesPerParticleEstimate(int dimensions);
+// Bytes the simulator's `method` needs per particle at peak, for the memory check and for reporting.
+size_t bytesPerParticleEstimate(int dimensions, const std::string& method = "pbf");
 
 // The memory this process may use: the least of the machine's physical memory, its cgroup's limit (v2
 // memory.max, v1 memory.limit_in_bytes) and a Slurm job's (SLURM_MEM_PER_NODE, or SLURM_MEM_PER_CPU times

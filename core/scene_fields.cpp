@@ -165,13 +165,14 @@ void visitScene(Scene& s, SceneVisitor& v) {
       [&](size_t i) { visitBody(v, s.bodies[i]); });
 
   v.group("solver", info("the simulator"), [&] {
-    v.choice("method", s.solver.method, {"pbf", "wcsph"},
+    v.choice("method", s.solver.method, {"pbf", "wcsph", "dfsph"},
              info("pbf: Position Based Fluids (Macklin & Mueller 2013); wcsph: weakly compressible SPH "
-                  "(Monaghan 1994, Becker & Teschner 2007)"));
+                  "(Monaghan 1994, Becker & Teschner 2007); dfsph: Divergence-Free SPH (Bender & Koschier 2015, "
+                  "2017)"));
     v.integer("substeps", s.solver.substeps,
-              atLeast(0, "PBF: time steps per output frame (WCSPH chooses its own, see time_step); 0: 4, or more "
-                         "if the pool the fluid settles into is deep enough to need them (dt <= 0.9 "
-                         "particle_spacing / sqrt(g depth))", "", 100000));
+              atLeast(0, "PBF: time steps per output frame (WCSPH chooses its own, see time_step; DFSPH takes at "
+                         "least this many, from its CFL step); 0: 4, or more if the pool the fluid settles into is "
+                         "deep enough to need them (dt <= 0.9 particle_spacing / sqrt(g depth))", "", 100000));
     v.integer("iterations", s.solver.iterations, atLeast(1, "PBF: Jacobi iterations per step", "", 10000));
     v.real("kernel_radius", s.solver.kernel_radius,
            atLeast(0, "SPH kernel radius h; 0 means 2 x particle_spacing", "m"));
@@ -181,7 +182,13 @@ void visitScene(Scene& s, SceneVisitor& v) {
                       "constraint gradients (0.01 softens the constraint by 1%)"));
     v.real("max_density_error", s.solver.max_density_error,
            atLeast(0, "PBF: when > 0, iterate until the average density error (a fraction) is under it, at most "
-                      "`iterations` times; 0 runs exactly `iterations`"));
+                      "`iterations` times; 0 runs exactly `iterations`. DFSPH: its density solver's limit on the "
+                      "average predicted compression; 0 means 0.0005"));
+    v.integer("max_iterations", s.solver.max_iterations,
+              atLeast(1, "DFSPH: the most iterations each of its two solvers takes a step", "", 10000));
+    v.real("max_divergence_error", s.solver.max_divergence_error,
+           positive("DFSPH: its divergence solver iterates until the average density change that the "
+                    "velocity divergence would cause over one step (compression only, a fraction) is under it"));
     v.real("scorr_k", s.solver.scorr_k,
            atLeast(0, "PBF eq. 13 artificial pressure k, in units of the rest lattice's lambda; 0 turns s_corr off"));
     v.integer("scorr_n", s.solver.scorr_n, atLeast(1, "PBF eq. 13 exponent n", "", 16));
@@ -193,9 +200,11 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.real("vorticity_epsilon", s.solver.vorticity_epsilon,
            atLeast(0, "PBF eq. 16 vorticity confinement epsilon; 0 turns it off", "m/s"));
     v.real("xsph_c", s.solver.xsph_c,
-           atLeast(0, "PBF eq. 17 XSPH viscosity c (weights scaled by the particle volume); 0 turns it off", "", 1));
+           atLeast(0, "PBF eq. 17 XSPH viscosity c (weights scaled by the particle volume), also DFSPH's; 0 turns "
+                      "it off", "", 1));
     v.choice("kernel", s.solver.kernel, {"cubic_spline", "wendland_c2"},
-             info("WCSPH smoothing kernel, support kernel_radius: cubic spline (Monaghan 1992) or Wendland C2"));
+             info("WCSPH and DFSPH smoothing kernel, support kernel_radius: cubic spline (Monaghan 1992) or "
+                  "Wendland C2"));
     v.choice("equation_of_state", s.solver.equation_of_state, {"tait", "linear"},
              info("WCSPH: tait, p = rho_0 c^2 / 7 ((rho / rho_0)^7 - 1); linear, p = k (rho - rho_0); negative "
                   "pressures are clamped to 0"));
@@ -206,8 +215,11 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.choice("integrator", s.solver.integrator, {"velocity_verlet", "symplectic_euler"},
              info("WCSPH time integration: velocity Verlet (kick-drift-kick) or semi-implicit Euler"));
     v.real("time_step", s.solver.time_step,
-           atLeast(0, "WCSPH: a fixed step; 0 chooses each step from the CFL, viscous and force limits", "s"));
-    FieldInfo cfl = positive("WCSPH Courant number: dt <= cfl h / (c + |v|max), h = kernel_radius / 2");
+           atLeast(0, "WCSPH: a fixed step; 0 chooses each step from the CFL condition and the viscous and "
+                      "force limits. DFSPH: the largest step (its CFL step may be shorter); 0 means one frame / "
+                      "substeps", "s"));
+    FieldInfo cfl = positive("Courant number. WCSPH: dt <= cfl h / (c + |v|max), h = kernel_radius / 2; DFSPH: "
+                             "dt <= cfl particle_spacing / |v|max");
     cfl.max = 1;
     v.real("cfl", s.solver.cfl, cfl);
     v.real("artificial_viscosity", s.solver.artificial_viscosity,

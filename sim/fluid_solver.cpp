@@ -1,6 +1,7 @@
 #include "sim/fluid_solver.h"
 
 #include "core/errors.h"
+#include "sim/dfsph_solver.h"
 #include "sim/pbf_solver.h"
 #include "sim/wcsph_solver.h"
 
@@ -26,6 +27,7 @@ template <int Dim>
 const Registration<Dim> kMethods[] = {
     {"pbf", &make<PbfSolver, Dim>},
     {"wcsph", &make<WcsphSolver, Dim>},
+    {"dfsph", &make<DfsphSolver, Dim>},
 };
 
 }  // namespace

@@ -35,18 +35,25 @@ class FluidSolver {
   // length (stableTimeStep, read before every step).
   virtual int fixedSubsteps() const = 0;
   virtual float stableTimeStep() = 0;
-  // The start of an output frame at `time`. A method that carries state between steps beyond positions and
-  // velocities (stored accelerations, warm starts) forgets it here, so that a run resumed from a frame file
-  // continues exactly as an uninterrupted one.
+  // The start of an output frame at `time`. A method that keeps state between steps beyond positions and
+  // velocities either forgets it here (WCSPH's stored accelerations) or carries it (below), so that a run
+  // resumed from a frame file continues exactly as an uninterrupted one.
   virtual void beginFrame(double time) = 0;
+  // What a method carries from frame to frame beyond positions and velocities (DFSPH's warm starts), in the
+  // order of getParticles: the frame loop writes it beside each particle frame and gives it back on resume.
+  // Empty for a method that carries nothing.
+  virtual std::vector<float> carriedState() const { return {}; }
+  virtual void restoreCarriedState(const std::vector<float>&) {}
   // One step of dt from `time`. Returns the index of the first particle that is not finite, left the tank or
   // ran away (firstParticleOutside), or -1 if all are well.
   virtual long step(float dt, double time) = 0;
 
-  // What stats.csv reports: the measures of the current state, the last step's solver iterations, the largest
-  // pressure this frame (NaN for a method without pressures) and the time spent per phase.
+  // What stats.csv reports: the measures of the current state, the last step's solver iterations (density, and
+  // divergence for a method with a divergence solver, else -1), the largest pressure this frame (NaN for a
+  // method without pressures) and the time spent per phase.
   virtual FluidMeasures measure() = 0;
   virtual int lastIterations() const = 0;
+  virtual int lastDivergenceIterations() const { return -1; }
   virtual float maxPressure() const { return NAN; }
   virtual PhaseTimes& phaseTimes() = 0;
 

@@ -202,5 +202,6 @@ template class NeighborGrid<3>;
 template void gatherByOrder(const std::vector<uint32_t>&, std::vector<Vec<2>>&, std::vector<Vec<2>>&);
 template void gatherByOrder(const std::vector<uint32_t>&, std::vector<Vec<3>>&, std::vector<Vec<3>>&);
 template void gatherByOrder(const std::vector<uint32_t>&, std::vector<uint32_t>&, std::vector<uint32_t>&);
+template void gatherByOrder(const std::vector<uint32_t>&, std::vector<float>&, std::vector<float>&);
 
 }  // namespace surge

@@ -10,6 +10,7 @@
 // beyond the neighbour pairs themselves.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -43,6 +44,20 @@ struct NeighborLists {
     return ends.empty() ? 0 : sum + (ends.size() % kChunk ? ends.back() : 0);
   }
 };
+
+// Sizes `perPair`, one array a chunk of `lists`, to hold a value for every neighbour pair (indexed as the lists
+// are, by NeighborLists::start): the per-pair values a solver keeps beside its lists. Capacities are kept.
+template <typename T>
+void sizeForPairs(const NeighborLists& lists, std::vector<std::vector<T>>& perPair) {
+  perPair.resize(lists.chunks.size());
+  for (size_t c = 0; c < lists.chunks.size(); ++c) {
+    const size_t last = std::min(lists.size(), (c + 1) * NeighborLists::kChunk) - 1;
+    if (perPair[c].size() < lists.ends[last]) {
+      perPair[c].reserve(lists.chunks[c].size());
+      perPair[c].resize(lists.ends[last]);
+    }
+  }
+}
 
 template <int Dim>
 class NeighborGrid {

@@ -148,14 +148,7 @@ void PbfSolver<Dim>::findNeighbors() {
   gatherByOrder(order, p_, scratch_);
   gatherByOrder(order, id_, scratchIds_);
   grid_.findNeighbors(p_, kernels_.radius(), neighbors_);
-  pairGradientFactors_.resize(neighbors_.chunks.size());
-  for (size_t c = 0; c < neighbors_.chunks.size(); ++c) {
-    const size_t last = std::min(size(), (c + 1) * NeighborLists::kChunk) - 1;
-    if (pairGradientFactors_[c].size() < neighbors_.ends[last]) {
-      pairGradientFactors_[c].reserve(neighbors_.chunks[c].size());
-      pairGradientFactors_[c].resize(neighbors_.ends[last]);
-    }
-  }
+  sizeForPairs(neighbors_, pairGradientFactors_);
   times_.neighbors += millisecondsSince(start);
 }
 

@@ -65,10 +65,11 @@ class CsvFile {
   fs::path path_;
 };
 
-// pressureMax is NaN for a solver without pressures (PBF) and written as an empty field.
+// pressureMax is NaN for a solver without pressures (PBF), divergenceIterations for one without a divergence
+// solver (PBF, WCSPH); either is then written as an empty field.
 std::string statsRow(int frame, double time, size_t particles, int substeps, double iterations,
                      const FluidMeasures& m, double wallSeconds, const PhaseTimes& t, double timeStep,
-                     double pressureMax, const DamBreakMeasures& dam) {
+                     double pressureMax, const DamBreakMeasures& dam, double divergenceIterations) {
   char row[512];
   std::snprintf(row, sizeof row, "%d,%.6f,%zu,%d,%.2f,%.6g,%.6g,%.6g,%.4f,%.2f,%.2f,%.2f,%.2f,%.6g,", frame, time,
                 particles, substeps, iterations, m.densityErrorAvg, m.densityErrorMax, m.kineticEnergy,
@@ -76,6 +77,11 @@ std::string statsRow(int frame, double time, size_t particles, int substeps, dou
   std::string text = row;
   if (!std::isnan(pressureMax)) {
     std::snprintf(row, sizeof row, "%.6g", pressureMax);
+    text += row;
+  }
+  text += ",";
+  if (!std::isnan(divergenceIterations)) {
+    std::snprintf(row, sizeof row, "%.2f", divergenceIterations);
     text += row;
   }
   std::snprintf(row, sizeof row, ",%.6g,%.6g", dam.frontX, dam.backHeight);
@@ -205,6 +211,33 @@ void writeBodyFrame(const Scene& scene, const ColliderShapes& shapes, const Rigi
   writeBodyStates(framePath(dir, "bodies", frame, "txt"), scene, bodies.states());
 }
 
+// A method's carried state (FluidSolver::carriedState) at frame f: solver/frame_NNNNN.bin, raw floats, written
+// before the particle frame (which commits the frame). Only the last two are kept: a run resumes from its last.
+void writeCarriedState(const fs::path& dir, int frame, const std::vector<float>& state) {
+  fs::create_directories(dir / "solver");
+  writeFileAtomically(framePath(dir, "solver", frame, "bin"), [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(state.data()), std::streamsize(state.size() * sizeof(float)));
+  });
+  std::error_code error;
+  if (frame >= 2) fs::remove(framePath(dir, "solver", frame - 2, "bin"), error);
+}
+
+std::vector<float> readCarriedState(const fs::path& dir, int frame, size_t count) {
+  const fs::path path = framePath(dir, "solver", frame, "bin");
+  std::error_code error;
+  if (!fs::exists(path, error))
+    throw RunError("cannot resume from frame " + std::to_string(frame) + ": " + path.string() +
+                   ", the solver's state there, is missing");
+  const std::string bytes = readTextFile(path);
+  if (bytes.size() != count * sizeof(float))
+    throw RunError("cannot resume from frame " + std::to_string(frame) + ": " + path.string() + " holds " +
+                   std::to_string(bytes.size()) + " bytes, not the " + std::to_string(count * sizeof(float)) +
+                   " of this scene's particles");
+  std::vector<float> state(count);
+  std::memcpy(state.data(), bytes.data(), bytes.size());
+  return state;
+}
+
 // The frame loop, for any solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
 // otherwise each step is the largest stable one (stableTimeStep) shortened so the steps left end exactly on the
 // frame: dt = remaining / ceil(remaining / stable).
@@ -214,6 +247,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
   const auto runStart = std::chrono::steady_clock::now();
   const fs::path particleDir = dir / "particles";
   removeStaleFiles(particleDir, !resume);
+  removeStaleFiles(dir / "solver", !resume);
   fs::create_directories(particleDir);
 
   const std::unique_ptr<FluidSolver<Dim>> method = makeFluidSolver<Dim>(scene, shapes);
@@ -235,6 +269,9 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     const ParticleFrame frame = readParticlePly(path);
     if (frame.dimensions != Dim) throw InputError(path.string(), "dimensions", "differs from the scene's");
     solver.setParticles(frame);
+    const size_t carried = solver.carriedState().size();
+    if (carried > 0 && summary.firstFrame < scene.output.frames)
+      solver.restoreCarriedState(readCarriedState(dir, summary.firstFrame, carried));
     if (bodies) bodies->setStates(readBodyStates(framePath(dir, "bodies", summary.firstFrame, "txt"), scene));
   } else {
     ParticleFrame initial = initialParticles(scene);
@@ -257,11 +294,13 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
   if (fresh) {
     solver.getParticles(frame);
     stats.add(statsRow(0, 0.0, solver.size(), 0, 0, solver.measure(), 0.0, PhaseTimes{}, 0.0, NAN,
-                       measureDamBreak(scene, frame)));
+                       measureDamBreak(scene, frame), solver.lastDivergenceIterations() < 0 ? NAN : 0.0));
     if (bodies) {
       bodyTable->add(bodyRows(scene, 0, bodies->states(), std::vector<Wrench>(bodies->size())));
       writeBodyFrame(scene, *shapes, *bodies, dir, 0);
     }
+    const std::vector<float> state = solver.carriedState();
+    if (!state.empty()) writeCarriedState(dir, 0, state);
     writeParticlePly(framePath(dir, "particles", 0, "ply"), frame);
   }
 
@@ -278,7 +317,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
       bodies->beginFrame(time);
       placeBodies(*bodies, solver.colliders());
     }
-    int iterations = 0, steps = 0;
+    int iterations = 0, divergenceIterations = 0, steps = 0;
     float smallestStep = INFINITY;
     double remaining = frameDuration;
     while (remaining > 0) {
@@ -300,6 +339,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
                        ": body " + scene.bodies[badBody].solid.name + " (its state is not finite)");
       smallestStep = std::min(smallestStep, dt);
       iterations += solver.lastIterations();
+      divergenceIterations += solver.lastDivergenceIterations();
       if (bad >= 0) {
         solver.getParticles(frame);
         diverged(scene, f, steps, bad, frame);
@@ -314,7 +354,8 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     // The row first, the frame second: a run killed between them resumes from the frame before, whose rows
     // are the ones kept, so stats.csv never misses a frame that is on disk.
     stats.add(statsRow(f, f * frameDuration, solver.size(), steps, double(iterations) / steps, measures, seconds,
-                       solver.phaseTimes(), smallestStep, solver.maxPressure(), measureDamBreak(scene, frame)));
+                       solver.phaseTimes(), smallestStep, solver.maxPressure(), measureDamBreak(scene, frame),
+                       divergenceIterations < 0 ? NAN : double(divergenceIterations) / steps));
     if (colliding || bodies) {
       std::vector<Wrench> wrenches = solver.takeColliderWrenches(frameDuration);
       const auto firstBody = wrenches.begin() + std::ptrdiff_t(scene.colliders.size());
@@ -328,6 +369,8 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
         writeMovingColliderMeshes(scene, *shapes, dir, f);
       }
     }
+    const std::vector<float> state = solver.carriedState();
+    if (!state.empty()) writeCarriedState(dir, f, state);
     writeParticlePly(framePath(dir, "particles", f, "ply"), frame);
     progress.advance();
   }
@@ -342,7 +385,8 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
 
 const char* statsCsvHeader() {
   return "frame,time,particles,substeps,iterations,density_error_avg,density_error_max,kinetic_energy,"
-         "wall_seconds,ms_neighbors,ms_constraint,ms_vorticity,ms_viscosity,time_step,pressure_max,front_x,back_height";
+         "wall_seconds,ms_neighbors,ms_constraint,ms_vorticity,ms_viscosity,time_step,pressure_max,divergence_iterations,"
+         "front_x,back_height";
 }
 
 DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame) {

@@ -60,7 +60,7 @@ const char* kPaddle = R"(colliders=[{"name": "paddle", "shape": "box", "size": [
 
 struct ExtremeCase {
   std::string name;
-  std::vector<std::string> pbf, wcsph;  // --set assignments per solver (plus solver.method)
+  std::vector<std::string> pbf, wcsph, dfsph;  // --set assignments per solver (plus solver.method)
 };
 
 // So that gtest and ctest name a case by its name, not its bytes.
@@ -72,8 +72,8 @@ std::string box(const std::string& min, const std::string& max, const std::strin
 }
 
 // The largest 3D particle count whose memory estimate fits in 2 GiB, as a cube of n^3 lattice points.
-int largestCube() {
-  const double most = double(size_t(1) << 31) / double(bytesPerParticleEstimate(3));
+int largestCube(const std::string& method = "pbf") {
+  const double most = double(size_t(1) << 31) / double(bytesPerParticleEstimate(3, method));
   int n = static_cast<int>(std::cbrt(most));
   while (double(n + 1) * (n + 1) * (n + 1) <= most) ++n;
   while (double(n) * n * n > most) --n;
@@ -95,39 +95,48 @@ std::string number(double value) {
 
 std::vector<ExtremeCase> cases() {
   const std::string tiny = number(kSmallestSpacing), tenTiny = number(10 * kSmallestSpacing);
-  const int n = largestCube();
-  const std::string big = number(n * 0.01);  // spacing 0.01: an n^3 block
+  const int n = largestCube(), nd = largestCube("dfsph");
+  const std::string big = number(n * 0.01), bigd = number(nd * 0.01);  // spacing 0.01: an n^3 block
   return {
-      {"OneSubstepPerFrame", {"solver.substeps=1", "output.fps=30"}, {"solver.time_step=" + number(1.0 / 30), "output.fps=30"}},
-      {"OneIteration", {"solver.iterations=1"}, {"solver.cfl=1"}},
-      // 100 iterations are 25 x the default's work: 10 frames keep it to seconds.
+      {"OneSubstepPerFrame", {"solver.substeps=1", "output.fps=30"}, {"solver.time_step=" + number(1.0 / 30), "output.fps=30"},
+       {"solver.time_step=" + number(1.0 / 30), "output.fps=30"}},  // DFSPH: at most, its CFL step may be shorter
+      {"OneIteration", {"solver.iterations=1"}, {"solver.cfl=1"}, {"solver.max_iterations=1", "solver.cfl=1"}},
+      // 100 iterations are 25 x the default's work: 10 frames keep it to seconds. DFSPH: a limit it cannot
+      // reach, so that both its solvers run their 100.
       {"HundredIterations", {"solver.iterations=100", "output.frames=10"},
-       {"solver.speed_of_sound=313.2", "output.frames=10"}},  // 10 x the default 10 x sqrt(2 g 0.5 m)
+       {"solver.speed_of_sound=313.2", "output.frames=10"},  // 10 x the default 10 x sqrt(2 g 0.5 m)
+       {"solver.max_iterations=100", "solver.max_density_error=1e-9", "solver.max_divergence_error=1e-9", "output.frames=10"}},
       // A block thrown at 30 m/s into the right wall, which it reaches in 12 ms.
       {"ThrownAt30MetresPerSecond",
        {"fluids=[" + box("[0.4, 0.1, 0]", "[0.6, 0.3, 0.16]", "[30, 0, 0]") + "]", "output.frames=6"},
+       {"fluids=[" + box("[0.4, 0.1, 0]", "[0.6, 0.3, 0.16]", "[30, 0, 0]") + "]", "output.frames=6"},
        {"fluids=[" + box("[0.4, 0.1, 0]", "[0.6, 0.3, 0.16]", "[30, 0, 0]") + "]", "output.frames=6"}},
-      {"DomainTenToOneLong", {"domain.max=[5.0, 0.5, 0.16]"}, {"domain.max=[5.0, 0.5, 0.16]"}},
+      {"DomainTenToOneLong", {"domain.max=[5.0, 0.5, 0.16]"}, {"domain.max=[5.0, 0.5, 0.16]"}, {"domain.max=[5.0, 0.5, 0.16]"}},
       {"SingleParticle",
+       {"fluids=[" + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "]"},
        {"fluids=[" + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "]"},
        {"fluids=[" + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "]"}},
       {"TwoParticlesOnTopOfEachOther",
+       {"fluids=[" + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "," + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "]"},
        {"fluids=[" + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "," + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "]"},
        {"fluids=[" + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "," + box("[0.5, 0.2, 0.06]", "[0.52, 0.22, 0.08]") + "]"}},
       // A plate one spacing thick across the whole tank (through its walls) under a column thrown down at 30 m/s,
       // and a paddle swept through the dam break at 3 m/s: nothing may pass the plate or end inside either.
       {"ThinPlateUnderAColumnAt30MetresPerSecond",
        {"fluids=[" + box("[0.3, 0.2, 0]", "[0.6, 0.45, 0.16]", "[0, -30, 0]") + "]", kPlate, "output.frames=6"},
+       {"fluids=[" + box("[0.3, 0.2, 0]", "[0.6, 0.45, 0.16]", "[0, -30, 0]") + "]", kPlate, "output.frames=6"},
        {"fluids=[" + box("[0.3, 0.2, 0]", "[0.6, 0.45, 0.16]", "[0, -30, 0]") + "]", kPlate, "output.frames=6"}},
-      {"PaddleAt3MetresPerSecond", {kPaddle, "output.frames=9"}, {kPaddle, "output.frames=9"}},
+      {"PaddleAt3MetresPerSecond", {kPaddle, "output.frames=9"}, {kPaddle, "output.frames=9"}, {kPaddle, "output.frames=9"}},
       {"BodiesShotAt10MetresPerSecondAndAFiftiethAsDense", {kBodies, "output.frames=9"},
-       {kBodies, "output.frames=9"}},
+       {kBodies, "output.frames=9"}, {kBodies, "output.frames=9"}},
       // A 10 x 10 x 10 block at the smallest spacing; 3 frames. WCSPH's CFL step there is about 6 ns (0.4 h / c), so
   // a frame of 1/30 s would take 5.5 million steps (and stop on the frame loop's million-step guard after six
   // minutes): its frames are 1 us, about 170 steps each.
       {"SmallestSpacing",
        {"particle_spacing=" + tiny, "fluids=[" + box("[0, 0, 0]", "[" + tenTiny + "," + tenTiny + "," + tenTiny + "]") + "]",
         "output.frames=3"},
+       {"particle_spacing=" + tiny, "fluids=[" + box("[0, 0, 0]", "[" + tenTiny + "," + tenTiny + "," + tenTiny + "]") + "]",
+        "output.frames=3", "output.fps=1000000"},
        {"particle_spacing=" + tiny, "fluids=[" + box("[0, 0, 0]", "[" + tenTiny + "," + tenTiny + "," + tenTiny + "]") + "]",
         "output.frames=3", "output.fps=1000000"}},
       // n^3 particles (8.2 million), one frame of one step and one iteration: the memory and the size of the
@@ -138,7 +147,11 @@ std::vector<ExtremeCase> cases() {
         "solver.iterations=1"},
        {"particle_spacing=0.01", "domain.max=[" + number(2 * n * 0.01) + "," + number(1.5 * n * 0.01) + "," + big + "]",
         "fluids=[" + box("[0, 0, 0]", "[" + big + "," + big + "," + big + "]") + "]", "output.frames=1",
-        "solver.time_step=0.00005", "output.fps=20000"}},
+        "solver.time_step=0.00005", "output.fps=20000"},
+       // DFSPH holds more a particle (bytesPerParticleEstimate): its own largest cube.
+       {"particle_spacing=0.01", "domain.max=[" + number(2 * nd * 0.01) + "," + number(1.5 * nd * 0.01) + "," + bigd + "]",
+        "fluids=[" + box("[0, 0, 0]", "[" + bigd + "," + bigd + "," + bigd + "]") + "]", "output.frames=1",
+        "solver.time_step=0.00005", "output.fps=20000", "solver.max_iterations=1"}},
   };
 }
 
@@ -289,7 +302,7 @@ class Extremes : public testing::TestWithParam<std::tuple<ExtremeCase, std::stri
 TEST_P(Extremes, FiniteInsideTheTankOrACleanStop) {
   const ExtremeCase& c = std::get<0>(GetParam());
   const std::string& method = std::get<1>(GetParam());
-  std::vector<std::string> sets = method == "pbf" ? c.pbf : c.wcsph;
+  std::vector<std::string> sets = method == "pbf" ? c.pbf : method == "wcsph" ? c.wcsph : c.dfsph;
   sets.push_back("solver.method=" + method);
   const std::string name = std::to_string(::getpid()) + "_extreme_" + c.name + "_" + method;
   const fs::path scenePath = fs::path(testing::TempDir()) / (name + ".json");
@@ -357,7 +370,7 @@ std::string caseName(const testing::TestParamInfo<Extremes::ParamType>& info) {
   return std::get<0>(info.param).name + "_" + std::get<1>(info.param);
 }
 
-INSTANTIATE_TEST_SUITE_P(Matrix, Extremes, testing::Combine(testing::ValuesIn(cases()), testing::Values("pbf", "wcsph")),
+INSTANTIATE_TEST_SUITE_P(Matrix, Extremes, testing::Combine(testing::ValuesIn(cases()), testing::Values("pbf", "wcsph", "dfsph")),
                          caseName);
 
 // The cases sit at the edges, not past them: the scene check refuses a little further.

@@ -6,6 +6,7 @@
 
 #include "sim/pbf_solver.h"
 #include "sim/simulation.h"
+#include "sim/fluid_solver.h"
 #include "sim/wcsph_solver.h"
 
 namespace surge {
@@ -328,26 +329,18 @@ TEST(Colliders, SubmergedSphereFeelsArchimedesWcsph) {
 }
 
 // The force bookkeeping is exact where the model is: a plane laid as the tank's floor carries all the water's
-// weight once it is at rest (the side walls are vertical and frictionless), for both solvers, within 2% (the
+// weight once it is at rest (the side walls are vertical and frictionless), for every solver, within 2% (the
 // residual sloshing's mean over a second, and the corners the side walls share).
 TEST(Colliders, FloorPlaneCarriesAllTheWeight) {
-  for (const char* method : {"pbf", "wcsph"}) {
+  for (const std::string& method : fluidSolverMethods()) {
     const Scene scene = makeScene(2, R"({"min": [0, 0], "max": [0.6, 0.6]})", R"([{"box": {"min": [0, 0.1], "max": [0.6, 0.4]}}])",
                                   R"([{"shape": "plane", "position": [0.3, 0.1], "normal": [0, 1]}])", 0.02,
-                                  {std::string("solver.method=") + method});
+                                  {"solver.method=" + method});
     double time = 0;
-    Wrench w;
-    if (std::string(method) == "pbf") {
-      PbfSolver<2> solver(scene);
-      solver.setParticles(withoutInside<2>(scene, solver.colliders()));
-      runFor(solver, scene, 1.0, time);
-      w = meanWrench(solver, scene, 1.0, time);
-    } else {
-      WcsphSolver<2> solver(scene);
-      solver.setParticles(withoutInside<2>(scene, solver.colliders()));
-      runFor(solver, scene, 1.0, time);
-      w = meanWrench(solver, scene, 1.0, time);
-    }
+    const std::unique_ptr<FluidSolver<2>> solver = makeFluidSolver<2>(scene);
+    solver->setParticles(withoutInside<2>(scene, solver->colliders()));
+    runFor(*solver, scene, 1.0, time);
+    const Wrench w = meanWrench(*solver, scene, 1.0, time);
     const double weight = 1000 * 9.81 * 0.6 * 0.3;
     EXPECT_NEAR(-w.force.y(), weight, 0.02 * weight) << method;
     EXPECT_NEAR(w.force.x(), 0.0, 0.01 * weight) << method;

@@ -1,0 +1,143 @@
+// Divergence-Free SPH (Bender & Koschier, "Divergence-Free Smoothed Particle Hydrodynamics", SCA 2015, and
+// "Divergence-Free SPH for Incompressible and Viscous Fluids", TVCG 2017; "the paper" is the 2015 one, whose
+// algorithm numbers are used), in 2D and 3D, sharing the grid, the tank walls and the colliders with PBF and
+// WCSPH. One step is the paper's Algorithm 1:
+//   non-pressure forces       gravity, the attractor, XSPH viscosity (as PBF's eq. 17): v* = v + dt a
+//   correctDensityError       Algorithm 3: the constant-density solver on v*, until the average predicted
+//                             compression is under solver.max_density_error (at least 2 iterations)
+//   drift                     x += dt v*, stopped at the colliders and the tank
+//   neighbours, rho, alpha    the grid sort, rho_i = sum_j m W_ij and the factor alpha_i of the new positions
+//   correctDivergenceError    Algorithm 2: the divergence-free solver on v, until the average density change a
+//                             step of compression would cause is under solver.max_divergence_error (at least 1)
+// Both solvers are the paper's, written in the units of PBF's lambda (dimensionless, so warm starts carry over
+// steps of any length): with V = m / rho_0 and g_ij = V grad W_ij,
+//   S_i = |sum_j g_ij + G_i|^2 + sum_j |g_ij|^2          (rho_i / alpha_i over rho_0^2; G_i the walls')
+//   lambda_i = s_i / S_i                                  (kappa_i dt^2 / rho_i)
+//   v_i -= (1 / dt) (sum_j (lambda_i + lambda_j) g_ij + lambda_i G_i)   (the pressure force; walls as Akinci's)
+// where s_i is the predicted compression rho*_i / rho_0 - 1, rho*_i = rho_i + dt D rho_i / Dt, for the density
+// solver, and dt times the velocity divergence D rho_i / Dt / rho_0 = sum_j (v_i - v_j) . g_ij + v_i . G_i
+// (less the walls' own motion) for the divergence solver. The solvers are Jacobi iterations, relaxed by 0.5
+// (as SPlisHSPlasH's), on the accumulated lambda, projected to lambda >= 0 (no tension). Part of each one's
+// total starts it in the next step (the 2017 paper's warm start); the totals are carried state, written beside
+// each frame (FluidSolver::carriedState), so a run resumed from a frame continues exactly.
+// The tank's clamp (a particle radius inside its walls) bounds every velocity the solvers compute, so they
+// predict the move the clamp will allow: the walls, continued as the rest lattice (sim/tank.h), leave a
+// particle at rest against them with a density that does not change to first order as it slides into them,
+// and unbounded, the density solver let the first layer sink into the clamp and compressed the second by 25%.
+// Particles at the free surface (less than 80% of the rest density around them) take no divergence correction
+// of their own, as in the paper's implementation: it would hold splashes together.
+//
+// The step is from the CFL condition, dt = cfl particle_spacing / |v + g dt_max|max (the paper's dt <= 0.4 d / |v|
+// at cfl 0.4, d the particle diameter), at most dt_max = solver.time_step if set, else one frame / solver.substeps.
+// (Not a fixed step, as time_step is for WCSPH: beyond its CFL step the linear prediction of both solvers fails,
+// and a whole frame a step left a dam break 30% compressed after 100 iterations, and gaining energy.)
+#pragma once
+
+#include <vector>
+
+#include "core/ply.h"
+#include "core/scene.h"
+#include "sim/attractor.h"
+#include "sim/colliders.h"
+#include "sim/fluid_solver.h"
+#include "sim/kernels.h"
+#include "sim/measures.h"
+#include "sim/neighbor_grid.h"
+#include "sim/tank.h"
+
+namespace surge {
+
+template <int Dim>
+class DfsphSolver final : public FluidSolver<Dim> {
+ public:
+  using VecD = Vec<Dim>;
+
+  explicit DfsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes = nullptr);
+  DfsphSolver(const DfsphSolver&) = delete;
+  DfsphSolver& operator=(const DfsphSolver&) = delete;
+
+  void setParticles(const ParticleFrame& frame) override;
+  std::vector<float> carriedState() const override;
+  void restoreCarriedState(const std::vector<float>& state) override;
+  void getParticles(ParticleFrame& frame) const override;
+  size_t size() const override { return x_.size(); }
+  const std::vector<VecD>& positions() const override { return x_; }
+  const std::vector<VecD>& velocities() const override { return v_; }
+  float particleMass() const override { return mass_; }
+
+  int fixedSubsteps() const override { return 0; }
+  float stableTimeStep() override;
+  void beginFrame(double time) override;
+  long step(float dt, double time) override;
+
+  FluidMeasures measure() override;
+  int lastIterations() const override { return densityIterations_; }
+  int lastDivergenceIterations() const override { return divergenceIterations_; }
+  // The largest pressure of the frame's density solves, p_i = rho_0 lambda_i / dt^2.
+  float maxPressure() const override { return framePressureMax_; }
+  // Each particle's pressure in the last step's density solve, rho_0 lambda_i / dt^2, in the current order.
+  std::vector<float> pressures() const;
+  PhaseTimes& phaseTimes() override { return times_; }
+  Colliders<Dim>& colliders() override { return colliders_; }
+
+ private:
+  // Sorts the particles into the grid (reordering every channel) and computes, at the current positions, the
+  // neighbour lists, each pair's g_ij, each particle's wall gradient G_i, density ratio and S_i.
+  void prepareStep();
+  template <typename Kernel>
+  void computeFactors(const Kernel& kernel);
+  void applyNonPressureForces(float dt, double time);
+  // One of the two solvers (Algorithms 2 and 3): iterates on v_ until the average residual is at most `limit`
+  // (and at least `minimum` times, at most solver.max_iterations), starting from half of `warm` where the particle
+  // is compressed; `warm` ends as this solve's total. Returns the corrections applied.
+  int solve(bool density, float dt, double limit, int minimum, std::vector<float>& warm);
+  // s_i of the solver at the current velocities (the compression if density, else dt D rho / Dt / rho_0).
+  float residual(size_t i, bool density, float dt) const;
+  // v_i -= (1 / dt) (sum_j (d_i + d_j) g_ij + d_i G_i) for the lambda increments d.
+  void applyIncrements(const std::vector<float>& increments, float dt);
+  void keepInsideTank(size_t i, float dt);
+  // The impulses the colliders gave the particles through their share of G_i over this step's solves.
+  void recordColliderImpulses(const std::vector<float>& lambda, float dt);
+
+  // Calls use(kernel) with the scene's SPH kernel.
+  template <typename Use>
+  auto withKernel(Use&& use) const {
+    return wendland_ ? use(wendlandKernel_) : use(cubicKernel_);
+  }
+
+  // Parameters.
+  bool wendland_;
+  CubicSplineKernel<Dim> cubicKernel_;
+  WendlandC2Kernel<Dim> wendlandKernel_;
+  float support_, restDensity_, mass_, volume_, spacing_;
+  double maxDensityError_, maxDivergenceError_;
+  int maxIterations_;
+  float cfl_, maxStep_, xsphC_;
+  VecD gravity_, domainMin_, domainMax_;
+  Attractor<Dim> attractor_;
+
+  // Particle channels.
+  std::vector<VecD> x_, v_, scratch_;
+  std::vector<uint32_t> id_, scratchIds_;
+  std::vector<float> densityRatio_;  // rho_i / rho_0 at the current positions
+  std::vector<float> diagonal_;      // S_i
+  std::vector<VecD> wallGradient_;   // G_i, the tank's and the colliders'
+  std::vector<float> wallFlux_;      // sum_c V v_c . grad W over the colliders (moving walls); only with colliders
+  std::vector<float> densityWarm_, divergenceWarm_, increments_, floatScratch_;
+  std::vector<std::vector<VecD>> pairGradients_;  // g_ij, parallel to neighbors_
+  NeighborGrid<Dim> grid_;
+  TankWalls<Dim> walls_;
+  Colliders<Dim> colliders_;
+  NeighborLists neighbors_;
+  bool prepared_ = false;  // the factors are those of the current positions
+  float sceneSpeedLimit_ = 0, speedLimit_ = 0;
+
+  int densityIterations_ = 0, divergenceIterations_ = 0;
+  float framePressureMax_ = 0, lastStep_ = 0;
+  PhaseTimes times_;
+};
+
+extern template class DfsphSolver<2>;
+extern template class DfsphSolver<3>;
+
+}  // namespace surge
