@@ -100,15 +100,5 @@ done
 ours wcsph "Surge WCSPH"
 
 if command -v gnuplot >/dev/null; then
-  gnuplot <<PLOT
-set terminal pngcairo size 800,500 noenhanced
-set output "$work/methods_error_vs_cpu.png"
-set datafile separator ","
-set logscale xy
-set xlabel "CPU seconds (1 s of the dam break)"
-set ylabel "average density error, %"
-set key off
-set grid
-plot "$csv" every ::1 using 2:4 with points pointtype 7 pointsize 1.5, "$csv" every ::1 using 2:4:1 with labels offset char 1,1 left
-PLOT
+  gnuplot -e "csv='$csv'; png='$work/methods_error_vs_cpu.png'" "$(dirname "$0")/plot_methods.gp"
 fi
