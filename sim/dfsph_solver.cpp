@@ -145,6 +145,7 @@ void DfsphSolver<Dim>::prepareStep() {
   gatherByOrder(order, divergenceWarm_, floatScratch_);
   grid_.findNeighbors(x_, support_, neighbors_);
   sizeForPairs(neighbors_, pairGradients_);
+  if (xsphC_ > 0) sizeForPairs(neighbors_, pairWeights_);
   times_.neighbors += millisecondsSince(start);
   withKernel([&](const auto& kernel) {
     computeFactors(kernel);
@@ -172,11 +173,13 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
       float weight = selfWeight, squares = 0;
       VecD sum = VecD::Zero();
       VecD* g = pairGradients_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
+      float* w = xsphC_ > 0 ? pairWeights_[i / NeighborLists::kChunk].data() + neighbors_.start(i) : nullptr;
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++g) {
         const VecD r = xi - x_[*j];
-        const float length = r.norm();
-        weight += kernel.value(length);
-        *g = (volume_ * kernel.gradientFactor(length)) * r;
+        const auto k = kernel.pair(r.norm());
+        weight += k.value;
+        if (w) *w++ = k.value;
+        *g = (volume_ * k.gradientFactor) * r;
         sum += *g;
         squares += g->squaredNorm();
       }
@@ -219,16 +222,13 @@ void DfsphSolver<Dim>::applyNonPressureForces(float dt, double time) {
   if (xsphC_ > 0) {
     scratch_.resize(size());
     const float scale = xsphC_ * volume_;
-    withKernel([&](const auto& kernel) {
-      parallelFor(0, size(), [&](size_t b, size_t e) {
-        for (size_t i = b; i < e; ++i) {
-          VecD sum = VecD::Zero();
-          for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j)
-            sum += (v_[*j] - v_[i]) * kernel.value((x_[i] - x_[*j]).norm());
-          scratch_[i] = v_[i] + scale * sum;
-        }
-      });
-      return 0;
+    parallelFor(0, size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        VecD sum = VecD::Zero();
+        const float* w = pairWeights_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
+        for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++w) sum += (v_[*j] - v_[i]) * *w;
+        scratch_[i] = v_[i] + scale * sum;
+      }
     });
     v_.swap(scratch_);
   }
@@ -258,7 +258,7 @@ void DfsphSolver<Dim>::keepInsideTank(size_t i, float dt) {
 }
 
 template <int Dim>
-void DfsphSolver<Dim>::applyIncrements(const std::vector<float>& increments, float dt) {
+void DfsphSolver<Dim>::applyIncrements(const std::vector<float>& increments, float dt, std::vector<float>& total) {
   const float inverseDt = 1.0f / dt;
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
@@ -268,6 +268,7 @@ void DfsphSolver<Dim>::applyIncrements(const std::vector<float>& increments, flo
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++g) delta += (di + increments[*j]) * *g;
       v_[i] -= inverseDt * delta;
       keepInsideTank(i, dt);
+      total[i] += di;
     }
   });
 }
@@ -283,13 +284,12 @@ int DfsphSolver<Dim>::solve(bool density, float dt, double limit, int minimum, s
   bool warm = false;
   parallelFor(0, n, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
-      const float start = (density ? kDensityWarmStart : kDivergenceWarmStart) * total[i];
-      increments_[i] = start;
-      total[i] = start;
+      increments_[i] = (density ? kDensityWarmStart : kDivergenceWarmStart) * total[i];
+      total[i] = 0;  // applyIncrements adds the start
     }
   });
   for (size_t i = 0; i < n && !warm; ++i) warm = increments_[i] != 0;
-  if (warm) applyIncrements(increments_, dt);
+  if (warm) applyIncrements(increments_, dt, total);
 
   int corrections = 0;
   while (true) {
@@ -305,10 +305,7 @@ int DfsphSolver<Dim>::solve(bool density, float dt, double limit, int minimum, s
                          }) /
                          std::max<double>(1, n);
     if ((error <= limit && corrections >= minimum) || corrections >= maxIterations_) break;
-    applyIncrements(increments_, dt);
-    parallelFor(0, n, [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) total[i] += increments_[i];
-    });
+    applyIncrements(increments_, dt, total);
     ++corrections;
   }
   return corrections;

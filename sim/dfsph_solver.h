@@ -93,8 +93,8 @@ class DfsphSolver final : public FluidSolver<Dim> {
   int solve(bool density, float dt, double limit, int minimum, std::vector<float>& warm);
   // s_i of the solver at the current velocities (the compression if density, else dt D rho / Dt / rho_0).
   float residual(size_t i, bool density, float dt) const;
-  // v_i -= (1 / dt) (sum_j (d_i + d_j) g_ij + d_i G_i) for the lambda increments d.
-  void applyIncrements(const std::vector<float>& increments, float dt);
+  // v_i -= (1 / dt) (sum_j (d_i + d_j) g_ij + d_i G_i) for the lambda increments d, and total_i += d_i.
+  void applyIncrements(const std::vector<float>& increments, float dt, std::vector<float>& total);
   void keepInsideTank(size_t i, float dt);
   // The impulses the colliders gave the particles through their share of G_i over this step's solves.
   void recordColliderImpulses(const std::vector<float>& lambda, float dt);
@@ -125,6 +125,7 @@ class DfsphSolver final : public FluidSolver<Dim> {
   std::vector<float> wallFlux_;      // sum_c V v_c . grad W over the colliders (moving walls); only with colliders
   std::vector<float> densityWarm_, divergenceWarm_, increments_, floatScratch_;
   std::vector<std::vector<VecD>> pairGradients_;  // g_ij, parallel to neighbors_
+  std::vector<std::vector<float>> pairWeights_;   // W_ij for XSPH; only with xsph_c > 0
   NeighborGrid<Dim> grid_;
   TankWalls<Dim> walls_;
   Colliders<Dim> colliders_;

@@ -68,7 +68,12 @@ class Kernels {
   float poly6_, spiky_;
 };
 
-// The kernels of the weakly compressible solver, with support H (the scene's kernel_radius), q = r / H:
+// An SPH kernel's value and gradient factor at one distance (CubicSplineKernel::pair, WendlandC2Kernel::pair).
+struct SphKernelPair {
+  float value, gradientFactor;
+};
+
+// The kernels of the SPH methods (WCSPH, DFSPH), with support H (the scene's kernel_radius), q = r / H:
 //   cubic spline (Monaghan 1992, in the form of SPlisHSPlasH): 6 (q^3 - q^2) + 1 for q <= 1/2, 2 (1 - q)^3 for
 //     q <= 1, times 8 / (pi H^3) in 3D and 40 / (7 pi H^2) in 2D;
 //   Wendland C2 (Wendland 1995): (1 - q)^4 (1 + 4 q), times 21 / (2 pi H^3) in 3D and 7 / (pi H^2) in 2D.
@@ -95,6 +100,16 @@ class CubicSplineKernel {
     const float dWdq = q <= 0.5f ? 6.0f * q * (3.0f * q - 2.0f) : -6.0f * (1.0f - q) * (1.0f - q);
     return sigma_ * dWdq * inverseSupport_ / r;
   }
+  // value(r) and gradientFactor(r) at once, from one q.
+  SphKernelPair pair(float r) const {
+    const float q = r * inverseSupport_;
+    if (q >= 1.0f) return {0.0f, 0.0f};
+    const float d = 1.0f - q;
+    const bool inner = q <= 0.5f;
+    const float value = sigma_ * (inner ? 6.0f * (q * q * q - q * q) + 1.0f : 2.0f * d * d * d);
+    const float dWdq = inner ? 6.0f * q * (3.0f * q - 2.0f) : -6.0f * d * d;
+    return {value, r <= 1e-12f ? 0.0f : sigma_ * dWdq * inverseSupport_ / r};
+  }
 
  private:
   float support_, inverseSupport_, sigma_;
@@ -120,6 +135,14 @@ class WendlandC2Kernel {
     if (q >= 1.0f || r <= 1e-12f) return 0.0f;
     const float d = 1.0f - q;
     return sigma_ * (-20.0f * q * d * d * d) * inverseSupport_ / r;
+  }
+  // value(r) and gradientFactor(r) at once, from one q.
+  SphKernelPair pair(float r) const {
+    const float q = r * inverseSupport_;
+    if (q >= 1.0f) return {0.0f, 0.0f};
+    const float d = 1.0f - q;
+    return {sigma_ * d * d * d * d * (1.0f + 4.0f * q),
+            r <= 1e-12f ? 0.0f : sigma_ * (-20.0f * q * d * d * d) * inverseSupport_ / r};
   }
 
  private:

@@ -11,9 +11,12 @@
 namespace surge {
 namespace {
 
-// A dense cell array is used while the box holds at most this many cells per particle.
+// A dense cell array is used while the box holds at most this many cells per particle, or at most
+// kDenseCellsAlways cells (16 MB of starts): a dam break of 64,000 particles splashed over its 4 x 3 x 1.5 m tank
+// has 18 cells a particle, and searching its occupied cells cost 40% of a DFSPH step.
 constexpr uint64_t kDenseCellsPerParticle = 8;
 constexpr uint64_t kDenseCellsMinimum = 1 << 16;
+constexpr uint64_t kDenseCellsAlways = 1 << 22;
 
 }  // namespace
 
@@ -69,7 +72,8 @@ void NeighborGrid<Dim>::sort(const std::vector<Vec<Dim>>& positions) {
     cells *= static_cast<uint64_t>(resolution_[k]);
   }
   cellCount_ = cells;
-  sparse_ = cells > std::max<uint64_t>(kDenseCellsMinimum, kDenseCellsPerParticle * n) || cells >= (uint64_t(1) << 32);
+  sparse_ = cells > std::max({kDenseCellsMinimum, kDenseCellsAlways, kDenseCellsPerParticle * n}) ||
+            cells >= (uint64_t(1) << 32);
 
   order_.resize(n);
   if (!sparse_) {
@@ -110,6 +114,21 @@ void NeighborGrid<Dim>::sort(const std::vector<Vec<Dim>>& positions) {
     }
   }
   sparseStart_.push_back(static_cast<uint32_t>(n));
+  // The row index: where each row of cells along x starts among the occupied cells, so that a query searches
+  // the few occupied cells of its row instead of all of them (a dam break spread over its tank spent 55 ms a
+  // step of 64,000 particles in those searches). Kept within the dense path's budget of entries.
+  const uint64_t rows = cells / static_cast<uint64_t>(resolution_[0]);
+  rowIndexed_ = rows <= std::max<uint64_t>(kDenseCellsMinimum, kDenseCellsPerParticle * n);
+  if (!rowIndexed_) {
+    rowStart_.clear();
+    return;
+  }
+  rowStart_.resize(rows + 1);
+  size_t k = 0;
+  for (uint64_t row = 0; row <= rows; ++row) {
+    while (k < cellKeys_.size() && cellKeys_[k] / static_cast<uint64_t>(resolution_[0]) < row) ++k;
+    rowStart_[row] = static_cast<uint32_t>(k);
+  }
 }
 
 template <int Dim>
@@ -119,8 +138,15 @@ void NeighborGrid<Dim>::slotsOfCells(uint64_t first, uint64_t last, uint32_t& be
     end = cellStart_[last + 1];
     return;
   }
-  const auto lo = std::lower_bound(cellKeys_.begin(), cellKeys_.end(), first);
-  const auto hi = std::upper_bound(lo, cellKeys_.end(), last);
+  // first and last lie in one row of cells along x.
+  auto rowBegin = cellKeys_.begin(), rowEnd = cellKeys_.end();
+  if (rowIndexed_) {
+    const uint64_t row = first / static_cast<uint64_t>(resolution_[0]);
+    rowBegin = cellKeys_.begin() + rowStart_[row];
+    rowEnd = cellKeys_.begin() + rowStart_[row + 1];
+  }
+  const auto lo = std::lower_bound(rowBegin, rowEnd, first);
+  const auto hi = std::upper_bound(lo, rowEnd, last);
   begin = sparseStart_[lo - cellKeys_.begin()];
   end = sparseStart_[hi - cellKeys_.begin()];
 }

@@ -77,10 +77,11 @@ class NeighborGrid {
   // Cells of the last sort's box, and whether it used the sparse (sorted keys) path.
   uint64_t cellCount() const { return cellCount_; }
   size_t memoryBytes() const {
-    return cellStart_.capacity() * 4 + cellKeys_.capacity() * 8 + sparseStart_.capacity() * 4 +
+    return cellStart_.capacity() * 4 + cellKeys_.capacity() * 8 + sparseStart_.capacity() * 4 + rowStart_.capacity() * 4 +
            cellOfParticle_.capacity() * 4 + keyOfParticle_.capacity() * 8 + order_.capacity() * 4;
   }
   bool sparse() const { return sparse_; }
+  bool rowIndexed() const { return sparse_ && rowIndexed_; }
 
  private:
   using Cell = Eigen::Matrix<int64_t, Dim, 1>;
@@ -98,6 +99,8 @@ class NeighborGrid {
   std::vector<uint32_t> cellStart_;    // dense: per cell, its first slot (and past the last cell, the end)
   std::vector<uint64_t> cellKeys_;     // sparse: the occupied cells' linear indices, ascending
   std::vector<uint32_t> sparseStart_;  // sparse: per occupied cell, its first slot (plus one at the end)
+  std::vector<uint32_t> rowStart_;     // sparse: per row of cells along x, its first occupied cell (plus the end)
+  bool rowIndexed_ = false;            // sparse: rowStart_ is built (rows within the dense budget)
   std::vector<uint32_t> cellOfParticle_;  // dense: each particle's cell
   std::vector<uint64_t> keyOfParticle_;   // sparse: each particle's 64-bit cell key
   std::vector<uint32_t> order_;

@@ -107,6 +107,24 @@ TEST(NeighborGrid, SparsePathInALargeDomainMatchesBruteForce) {
   expectSameAsBruteForce<3>(x, Vec<3>(0, 0, 0), Vec<3>(100, 100, 100), 0.05f);
 }
 
+TEST(NeighborGrid, SparsePathWithARowIndexMatchesBruteForce) {
+  // 3000 particles in clumps strung along a tank 40 m long, 1 m wide and deep, with 1 cm cells: 40 million cells
+  // in the particles' box (sparse), in 10,000 rows along x (indexed).
+  std::mt19937 random(6);
+  std::uniform_real_distribution<float> u(0.0f, 0.05f);
+  std::vector<Vec<3>> x(3000);
+  for (size_t i = 0; i < x.size(); ++i) {
+    const float along = float(i % 30) * 1.33f, across = float(i % 7) * 0.14f;
+    x[i] = Vec<3>(along, across, 0.95f - across) + Vec<3>(u(random), u(random), u(random));
+  }
+  x[0] = Vec<3>(0, 0, 0);
+  x[1] = Vec<3>(40, 1, 1);
+  NeighborGrid<3> grid(Vec<3>(0, 0, 0), Vec<3>(40, 1, 1), 0.01f);
+  grid.sort(x);
+  EXPECT_TRUE(grid.rowIndexed());
+  expectSameAsBruteForce<3>(x, Vec<3>(0, 0, 0), Vec<3>(40, 1, 1), 0.01f);
+}
+
 TEST(NeighborGrid, DenseGridCoversOnlyTheParticlesBox) {
   // A clump in the corner of a large tank costs cells for the clump only.
   std::mt19937 random(5);
