@@ -10,10 +10,6 @@
 namespace surge {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double millisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // A particle with less than this fraction of the rest density around it (walls included) is at the free
 // surface: about 0.7 at a flat surface of the rest lattice, 0.95 one layer below it.
@@ -56,8 +52,6 @@ DfsphSolver<Dim>::DfsphSolver(const Scene& scene, std::shared_ptr<const Collider
                              : static_cast<float>(1.0 / (scene.output.fps * std::max(1, s.substeps)));
   xsphC_ = static_cast<float>(s.xsph_c);
   gravity_ = toVec<Dim>(scene.gravity);
-  domainMin_ = toVec<Dim>(scene.domain.min);
-  domainMax_ = toVec<Dim>(scene.domain.max);
 }
 
 template <int Dim>
@@ -115,7 +109,7 @@ long DfsphSolver<Dim>::step(float dt, double time) {
   applyNonPressureForces(dt, time);
 
   // Algorithm 3: the density solver on v*, then the move.
-  auto start = Clock::now();
+  auto start = PhaseClock::now();
   densityIterations_ = solve(true, dt, maxDensityError_, 2, densityWarm_);
   lastStep_ = dt;
   framePressureMax_ = std::max(framePressureMax_, restDensity_ / (dt * dt) * parallelMax(densityWarm_));
@@ -126,7 +120,7 @@ long DfsphSolver<Dim>::step(float dt, double time) {
 
   // The new positions' neighbours and factors, and Algorithm 2: the divergence solver on v.
   prepareStep();
-  start = Clock::now();
+  start = PhaseClock::now();
   divergenceIterations_ = solve(false, dt, maxDivergenceError_, 1, divergenceWarm_);
   if (!colliders_.empty()) recordColliderImpulses(divergenceWarm_, dt);
   times_.constraint += millisecondsSince(start);
@@ -135,7 +129,7 @@ long DfsphSolver<Dim>::step(float dt, double time) {
 
 template <int Dim>
 void DfsphSolver<Dim>::prepareStep() {
-  const auto start = Clock::now();
+  const auto start = PhaseClock::now();
   grid_.sort(x_);
   const std::vector<uint32_t>& order = grid_.sortedOrder();
   gatherByOrder(order, x_, scratch_);
@@ -159,7 +153,7 @@ void DfsphSolver<Dim>::prepareStep() {
 template <int Dim>
 template <typename Kernel>
 void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
-  const auto start = Clock::now();
+  const auto start = PhaseClock::now();
   const size_t n = size();
   densityRatio_.resize(n);
   diagonal_.resize(n);
@@ -210,7 +204,7 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
 // v += dt (g + the attractor); then XSPH: v_i += c sum_j V (v_j - v_i) W_ij.
 template <int Dim>
 void DfsphSolver<Dim>::applyNonPressureForces(float dt, double time) {
-  const auto start = Clock::now();
+  const auto start = PhaseClock::now();
   const bool attract = attractor_.active();
   const VecD attractorAt = attract ? attractor_.position(time) : VecD::Zero();
   parallelFor(0, size(), [&](size_t b, size_t e) {
@@ -246,17 +240,6 @@ float DfsphSolver<Dim>::residual(size_t i, bool density, float dt) const {
   return densityRatio_[i] < kSurfaceDensity ? 0.0f : dt * divergence;
 }
 
-// The tank's clamp (a radius inside each wall) as a bound on the velocity over the coming move, so that the
-// solvers predict the move the clamp will allow.
-template <int Dim>
-void DfsphSolver<Dim>::keepInsideTank(size_t i, float dt) {
-  const float radius = 0.5f * spacing_;
-  for (int k = 0; k < Dim; ++k) {
-    const float lowest = (domainMin_[k] + radius - x_[i][k]) / dt, highest = (domainMax_[k] - radius - x_[i][k]) / dt;
-    v_[i][k] = std::min(std::max(v_[i][k], std::min(lowest, 0.0f)), std::max(highest, 0.0f));
-  }
-}
-
 template <int Dim>
 void DfsphSolver<Dim>::applyIncrements(const std::vector<float>& increments, float dt, std::vector<float>& total) {
   const float inverseDt = 1.0f / dt;
@@ -267,7 +250,7 @@ void DfsphSolver<Dim>::applyIncrements(const std::vector<float>& increments, flo
       const VecD* g = pairGradients_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++g) delta += (di + increments[*j]) * *g;
       v_[i] -= inverseDt * delta;
-      keepInsideTank(i, dt);
+      walls_.boundVelocity(x_[i], v_[i], dt);
       total[i] += di;
     }
   });
@@ -280,7 +263,7 @@ template <int Dim>
 int DfsphSolver<Dim>::solve(bool density, float dt, double limit, int minimum, std::vector<float>& total) {
   const size_t n = size();
   increments_.resize(n);
-  // The warm start: half of last step's total where the particle is compressed now, applied before iterating.
+  // The warm start: a share of last step's total (kDensityWarmStart, kDivergenceWarmStart), applied first.
   bool warm = false;
   parallelFor(0, n, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {

@@ -95,7 +95,6 @@ class DfsphSolver final : public FluidSolver<Dim> {
   float residual(size_t i, bool density, float dt) const;
   // v_i -= (1 / dt) (sum_j (d_i + d_j) g_ij + d_i G_i) for the lambda increments d, and total_i += d_i.
   void applyIncrements(const std::vector<float>& increments, float dt, std::vector<float>& total);
-  void keepInsideTank(size_t i, float dt);
   // The impulses the colliders gave the particles through their share of G_i over this step's solves.
   void recordColliderImpulses(const std::vector<float>& lambda, float dt);
 
@@ -113,7 +112,7 @@ class DfsphSolver final : public FluidSolver<Dim> {
   double maxDensityError_, maxDivergenceError_;
   int maxIterations_;
   float cfl_, maxStep_, xsphC_;
-  VecD gravity_, domainMin_, domainMax_;
+  VecD gravity_;
   Attractor<Dim> attractor_;
 
   // Particle channels.

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <chrono>
 #include <vector>
 
 #include "core/parallel.h"
@@ -16,6 +17,12 @@ namespace surge {
 struct PhaseTimes {
   double neighbors = 0, constraint = 0, vorticity = 0, viscosity = 0;
 };
+
+// Milliseconds since `start`, for PhaseTimes.
+using PhaseClock = std::chrono::steady_clock;
+inline double millisecondsSince(PhaseClock::time_point start) {
+  return std::chrono::duration<double, std::milli>(PhaseClock::now() - start).count();
+}
 
 // Density error as DESIGN.md defines it (compression only, max(rho_i / rho_0 - 1, 0)) averaged and maximised
 // over the particles, and the kinetic energy.

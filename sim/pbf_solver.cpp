@@ -11,7 +11,6 @@
 namespace surge {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 // x^n for a small integer n by repeated multiplication (std::pow costs more than the rest of the pair).
 inline float integerPower(float x, int n) {
   float result = 1.0f;
@@ -19,9 +18,6 @@ inline float integerPower(float x, int n) {
   return result;
 }
 
-double millisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 
 }  // namespace
@@ -140,7 +136,7 @@ void PbfSolver<Dim>::applyFriction() {
 // Lines 5-7: neighbours of x*. Particles are reordered by cell first, every step, for memory locality.
 template <int Dim>
 void PbfSolver<Dim>::findNeighbors() {
-  const auto start = Clock::now();
+  const auto start = PhaseClock::now();
   grid_.sort(p_);
   const std::vector<uint32_t>& order = grid_.sortedOrder();
   gatherByOrder(order, x_, scratch_);
@@ -156,7 +152,7 @@ void PbfSolver<Dim>::findNeighbors() {
 // early once the average density error is under it; solver.iterations caps it either way.
 template <int Dim>
 void PbfSolver<Dim>::solveDensityConstraints() {
-  const auto start = Clock::now();
+  const auto start = PhaseClock::now();
   lastIterations_ = 0;
   for (int iteration = 0; iteration < iterations_; ++iteration) {
     const double averageError = computeLambdas();
@@ -297,7 +293,7 @@ void PbfSolver<Dim>::updateVelocities(float dt) {
 // The confinement force is applied as an acceleration: v_i += dt f_i.
 template <int Dim>
 void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
-  const auto start = Clock::now();
+  const auto start = PhaseClock::now();
   auto omegaMagnitude = [&](size_t j) { return Dim == 3 ? omega3_[j].norm() : std::abs(omega2_[j]); };
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
@@ -339,7 +335,7 @@ void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
 // (the particle volume) makes c dimensionless, as the paper's c = 0.01 assumes unit particle volume.
 template <int Dim>
 void PbfSolver<Dim>::applyXsphViscosity() {
-  const auto start = Clock::now();
+  const auto start = PhaseClock::now();
   scratch_.resize(size());
   const float scale = xsphC_ * massOverRho_;
   parallelFor(0, size(), [&](size_t b, size_t e) {

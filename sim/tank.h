@@ -207,6 +207,16 @@ class TankWalls {
     }
   }
 
+  // The clamp below as a bound on a velocity: over a move of dt from p, v may take the particle no further than
+  // the clamp allows (a particle already beyond it may still stand still). DFSPH bounds every velocity its
+  // solvers compute this way, so that they predict the move the clamp will allow.
+  void boundVelocity(const VecD& p, VecD& v, float dt) const {
+    for (int k = 0; k < Dim; ++k) {
+      const float lowest = (clampMin_[k] - p[k]) / dt, highest = (clampMax_[k] - p[k]) / dt;
+      v[k] = std::min(std::max(v[k], std::min(lowest, 0.0f)), std::max(highest, 0.0f));
+    }
+  }
+
   // Collision response: projects p back to a particle radius inside the tank. NaN stays NaN (comparisons with
   // NaN are false), so a diverged particle is reported rather than hidden at a wall. Returns the axes moved
   // as bits, so that a solver can stop the velocity into the wall.

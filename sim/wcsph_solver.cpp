@@ -7,15 +7,6 @@
 #include "sim/particle_channels.h"
 
 namespace surge {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-double millisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-
-}  // namespace
 
 template <int Dim>
 WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes)
@@ -142,7 +133,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
 template <int Dim>
 void WcsphSolver<Dim>::computeAccelerations(double time) {
   // Neighbours of the current positions; every channel is reordered by cell first.
-  const auto start = Clock::now();
+  const auto start = PhaseClock::now();
   grid_.sort(x_);
   const std::vector<uint32_t>& order = grid_.sortedOrder();
   gatherByOrder(order, x_, scratch_);
@@ -158,7 +149,7 @@ void WcsphSolver<Dim>::computeAccelerations(double time) {
 template <int Dim>
 template <typename Kernel>
 void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double time) {
-  auto start = Clock::now();
+  auto start = PhaseClock::now();
   const float selfWeight = kernel.value(0.0f);
   const bool near = nearStiffness_ > 0;
   const float inverseSupport = 1.0f / support_;
@@ -188,7 +179,7 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
   times_.constraint += millisecondsSince(start);
 
   // Forces, gathered per particle.
-  start = Clock::now();
+  start = PhaseClock::now();
   const VecD attractorAt = attractor_.active() ? attractor_.position(time) : VecD::Zero();
   const float h = smoothingLength_;
   const float eta2 = 0.01f * h * h;
