@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include "core/parallel.h"
 #include "sim/particle_channels.h"
@@ -59,6 +60,7 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
   scorrAtRest_ = integerPower(kernels_.poly6(spacing * spacing) * scorrInvWdq_, scorrN_);
   vorticityEpsilon_ = static_cast<float>(s.vorticity_epsilon);
   xsphC_ = static_cast<float>(s.xsph_c);
+  warmStart_ = static_cast<float>(s.warm_start);
   iterations_ = s.iterations;
   maxDensityError_ = s.max_density_error;
   gravity_ = toVec<Dim>(scene.gravity);
@@ -70,6 +72,7 @@ void PbfSolver<Dim>::setParticles(const ParticleFrame& frame) {
   const size_t n = frame.size();
   p_.resize(n);
   lambda_.assign(n, 0.0f);
+  if (warmStart_ > 0) lambdaTotal_.assign(n, 0.0f);
   colliders_.resetSlots(n);
   if (vorticityEpsilon_ > 0) (Dim == 3 ? omega3_.resize(n) : omega2_.resize(n));
   speedLimit_ = runawaySpeedFor(sceneSpeedLimit_, v_);
@@ -143,6 +146,7 @@ void PbfSolver<Dim>::findNeighbors() {
   gatherByOrder(order, v_, scratch_);
   gatherByOrder(order, p_, scratch_);
   gatherByOrder(order, id_, scratchIds_);
+  if (!lambdaTotal_.empty()) gatherByOrder(order, lambdaTotal_, scratchFloats_);
   grid_.findNeighbors(p_, kernels_.radius(), neighbors_);
   sizeForPairs(neighbors_, pairGradientFactors_);
   times_.neighbors += millisecondsSince(start);
@@ -154,13 +158,31 @@ template <int Dim>
 void PbfSolver<Dim>::solveDensityConstraints() {
   const auto start = PhaseClock::now();
   lastIterations_ = 0;
+  if (warmStart_ > 0) applyWarmStart();
   for (int iteration = 0; iteration < iterations_; ++iteration) {
     const double averageError = computeLambdas();
     if (maxDensityError_ > 0 && averageError <= maxDensityError_) break;
-    applyPositionCorrections();
+    applyPositionCorrections<false>();
     ++lastIterations_;
   }
+
   times_.constraint += millisecondsSince(start);
+}
+
+// The warm start: lambda_i = warm_start x the sum of particle i's lambdas last step, applied as one correction
+// (eq. 12) at this step's predicted positions; the sums start again from these lambdas.
+template <int Dim>
+void PbfSolver<Dim>::applyWarmStart() {
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) lambda_[i] = lambdaTotal_[i] = warmStart_ * lambdaTotal_[i];
+  });
+  applyPositionCorrections<true>();
+}
+
+template <int Dim>
+void PbfSolver<Dim>::restoreCarriedState(const std::vector<float>& state) {
+  if (state.size() != lambdaTotal_.size()) throw std::invalid_argument("PBF: carried state of the wrong size");
+  lambdaTotal_ = state;
 }
 
 // Eq. 2: rho_i = sum_j m W_poly6(p_i - p_j, h). Eq. 1: C_i = rho_i / rho_0 - 1, used one-sided (only
@@ -202,6 +224,8 @@ double PbfSolver<Dim>::computeLambdas() {
       }
       const float constraint = std::max(mass_ * weight / restDensity_ - 1.0f, 0.0f);
       lambda_[i] = -constraint / (gradientSquaredSum + gradientI.squaredNorm() + epsilon_);
+      // The warm start's sums forget a particle that is not compressed (see the header).
+      if (constraint == 0.0f && !lambdaTotal_.empty()) lambdaTotal_[i] = 0.0f;
       errorSum += constraint;
     }
     return errorSum;
@@ -220,14 +244,17 @@ double PbfSolver<Dim>::computeLambdas() {
 //    spray and thin sheets where nothing else keeps particles apart; in compressed fluid the constraint already
 //    does, and s_corr there adds pressure that the position update turns into kinetic energy.
 template <int Dim>
+template <bool kWarmStart>
 void PbfSolver<Dim>::applyPositionCorrections() {
-  const bool scorr = scorrK_ > 0;
+  const bool scorr = scorrK_ > 0 && !kWarmStart;
+  const bool sumLambdas = !kWarmStart && !lambdaTotal_.empty();
   scratch_.resize(size());  // the corrections, applied after all are computed (Jacobi)
   const float scorrScale = scorrK_ / latticeGradientSum_;
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const VecD pi = p_[i];
       const float lambdaI = lambda_[i];
+      if (sumLambdas) lambdaTotal_[i] += lambdaI;
       VecD delta = VecD::Zero();
       const float* factor = pairGradientFactors_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++factor) {
@@ -238,7 +265,8 @@ void PbfSolver<Dim>::applyPositionCorrections() {
           const float weight = kernels_.poly6(r.squaredNorm());
           coefficient = -scorrScale * std::max(integerPower(weight * scorrInvWdq_, scorrN_) - scorrAtRest_, 0.0f);
         }
-        delta += (coefficient * *factor) * r;
+        if constexpr (kWarmStart) delta += (coefficient * kernels_.pair(r.squaredNorm()).gradientFactor) * r;
+        else delta += (coefficient * *factor) * r;
       }
       // The walls do not move and carry no constraint of their own: only lambda_i acts along their gradient.
       float unusedWeight = 0;
@@ -383,7 +411,8 @@ template <int Dim>
 size_t PbfSolver<Dim>::memoryBytes() const {
   size_t bytes = (x_.capacity() + v_.capacity() + p_.capacity() + scratch_.capacity() + omega3_.capacity()) * sizeof(VecD);
   bytes += (id_.capacity() + scratchIds_.capacity()) * sizeof(uint32_t);
-  bytes += (lambda_.capacity() + omega2_.capacity()) * sizeof(float);
+  bytes += (lambda_.capacity() + lambdaTotal_.capacity() + scratchFloats_.capacity() + omega2_.capacity()) *
+           sizeof(float);
   for (const auto& factors : pairGradientFactors_) bytes += factors.capacity() * sizeof(float);
   return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes();
 }

@@ -2,11 +2,18 @@
 // One step is the paper's Algorithm 1, split into named phases:
 //   predictPositions        lines 1-4   apply external forces, predict x*
 //   findNeighbors           lines 5-7   sort into the grid, reorder particles, build neighbour lists
-//   solveDensityConstraints lines 8-19  Jacobi iterations: lambda (eq. 11), delta p with s_corr (eq. 12-14),
-//                                       collision response, x* += delta p
+//   solveDensityConstraints lines 8-19  a warm start (below), then Jacobi iterations: lambda (eq. 11), delta p
+//                                       with s_corr (eq. 12-14), collision response, x* += delta p
 //   updateVelocities        line 21     v = (x* - x) / dt
 //   vorticity + XSPH        line 22     vorticity confinement (eq. 15-16), XSPH viscosity (eq. 17)
 //   commit                  line 23     x = x*
+// The warm start (solver.warm_start, not in the paper): each particle's lambdas of a step are summed, and the
+// next step begins with one correction of eq. 12 by that share of the sums, as DFSPH warm-starts its pressure
+// (Bender & Koschier 2017, sec. 4.3). Fluid at rest then needs about half the correction each step, and a dam
+// break reaches the same density error in about half the iterations (docs/speed-accuracy.md). A particle found
+// uncompressed at any iteration forgets its sum: the constraint is one-sided, so a push that its neighbours no
+// longer resist is never taken back (without this a deep pool at 4 iterations boiled even at 0.5). The sums
+// are carried between frames (FluidSolver::carriedState), so a resumed run continues exactly.
 // Every loop gathers over neighbours and writes only its own particle, so results do not depend on the thread
 // count. A feature the scene turns off (s_corr k = 0, vorticity epsilon = 0, XSPH c = 0) runs no pass and holds
 // no memory.
@@ -54,6 +61,8 @@ class PbfSolver final : public FluidSolver<Dim> {
   long step(float dt, double time = 0) override;
 
   FluidMeasures measure() override;
+  std::vector<float> carriedState() const override { return lambdaTotal_; }
+  void restoreCarriedState(const std::vector<float>& state) override;
   int lastIterations() const override { return lastIterations_; }
   PhaseTimes& phaseTimes() override { return times_; }
   uint32_t particleId(size_t i) const { return id_[i]; }
@@ -70,6 +79,10 @@ class PbfSolver final : public FluidSolver<Dim> {
   void findNeighbors();
   void solveDensityConstraints();
   double computeLambdas();  // returns the average density error before this iteration's correction
+  void applyWarmStart();
+  // Eq. 12 from lambda_: an iteration's correction, or with kWarmStart the warm start's (kernel gradients
+  // evaluated here rather than read from the lambda pass, no s_corr, nothing added to the lambda totals).
+  template <bool kWarmStart>
   void applyPositionCorrections();
   void updateVelocities(float dt);
   void collide(size_t i, const VecD& from, bool fromStepStart);
@@ -90,6 +103,7 @@ class PbfSolver final : public FluidSolver<Dim> {
   int scorrN_;
   float coincidentLength_;
   float vorticityEpsilon_, xsphC_;
+  float warmStart_;
   int iterations_;
   double maxDensityError_;
   VecD gravity_;
@@ -100,6 +114,8 @@ class PbfSolver final : public FluidSolver<Dim> {
   std::vector<VecD> x_, v_, p_;
   std::vector<uint32_t> id_;
   std::vector<float> lambda_;
+  std::vector<float> lambdaTotal_;  // the sums of each particle's lambdas this step; only with the warm start
+  std::vector<float> scratchFloats_;
   std::vector<VecD> omega3_;    // vorticity (3D); allocated only when vorticity confinement is on
   std::vector<float> omega2_;   // vorticity (2D, a scalar)
   std::vector<VecD> scratch_;  // reordering, position corrections and XSPH velocities, in turn

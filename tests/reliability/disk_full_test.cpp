@@ -107,7 +107,14 @@ TEST(DiskFull, DiskFillingInEveryStageIsOneLineNoPartialFrameAndResumeEndsOnTheS
     // Nothing partial under a frame's name; the temporaries of the failed writes are gone.
     for (const auto& [name, bytes] : folderContents(out)) {
       EXPECT_EQ(name.find(".tmp"), std::string::npos) << name << " left after the disk filled in " << kStages[stage];
-      if (name.find("frame_") != std::string::npos || name == "killed.mp4") {
+      if (name.rfind("solver/", 0) == 0 && !expected.count(name)) {
+        // The solver's state is kept for the last two frames only, so an interrupted run holds earlier frames'
+        // than the whole one: each must still be whole, the same size as the whole run's.
+        const std::string last = framePath(fs::path(), "solver", kLastFrame, "bin").string();
+        ASSERT_TRUE(expected.count(last)) << last << " missing from the whole run";
+        EXPECT_EQ(bytes.size(), expected.at(last).size())
+            << name << " is not whole after the disk filled in " << kStages[stage];
+      } else if (name.find("frame_") != std::string::npos || name == "killed.mp4") {
         EXPECT_TRUE(expected.count(name) && bytes == expected.at(name))
             << name << " is not whole after the disk filled in " << kStages[stage];
       }
