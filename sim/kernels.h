@@ -30,8 +30,7 @@ class Kernels {
 
   // W_poly6(r, h) from the squared distance r2.
   float poly6(float r2) const {
-    if (r2 >= h2_) return 0.0f;
-    const float d = h2_ - r2;
+    const float d = std::max(h2_ - r2, 0.0f);  // branch-free, for the vectorised loops
     return poly6_ * d * d * d;
   }
 

@@ -12,12 +12,18 @@
 namespace surge {
 namespace {
 
-// x^n for a small integer n by repeated multiplication (std::pow costs more than the rest of the pair).
+// x^n for an integer 1 <= n <= 16 by squaring (std::pow costs more than the rest of the pair), with no branch
+// on x, so that it vectorises.
 inline float integerPower(float x, int n) {
-  float result = 1.0f;
-  for (int k = 0; k < n; ++k) result *= x;
-  return result;
+  const float x2 = x * x, x4 = x2 * x2, x8 = x4 * x4, x16 = x8 * x8;
+  return (n & 1 ? x : 1.0f) * (n & 2 ? x2 : 1.0f) * (n & 4 ? x4 : 1.0f) * (n & 8 ? x8 : 1.0f) * (n & 16 ? x16 : 1.0f);
 }
+
+// The neighbour loops of the two passes are written for the compiler's vectoriser (#pragma omp simd, built
+// with -fopenmp-simd): plain floats, no branch that depends on the pair, sums kept in lanes and added at the
+// end. The order of those sums depends on the vector width the build targets (so a build for another -march
+// may differ in the last bits), never on the thread count. A pair closer than coincidentLength_ (see
+// coincidentOffset) is rare; its particle is done again by the scalar loop beside.
 
 
 
@@ -199,16 +205,44 @@ double PbfSolver<Dim>::computeLambdas() {
       float weight = selfWeight;
       VecD gradientSum = VecD::Zero();  // sum_j grad W, times m / rho_0 below
       float gradientSquaredSum = 0;     // sum_j |grad W|^2, times (m / rho_0)^2 below
-      float* factor = pairGradientFactors_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
-      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
-        VecD r = pi - p_[*j];
-        if (r.squaredNorm() <= coincidentLength_ * coincidentLength_) [[unlikely]] r = coincidentOffset(i, *j);
-        const float r2 = r.squaredNorm();
-        const auto k = kernels_.pair(r2);
-        *factor++ = k.gradientFactor;
-        weight += k.weight;
-        gradientSum += k.gradientFactor * r;
-        gradientSquaredSum += k.gradientFactor * k.gradientFactor * r2;
+      float* factors = pairGradientFactors_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
+      const uint32_t* neighbor = neighbors_.begin(i);
+      const int count = static_cast<int>(neighbors_.end(i) - neighbor);
+      // The vectorised loop (see the note at the top); a coincident pair sends the particle to the scalar loop after it.
+      const float* p = p_.data()->data();
+      float w = 0, g0 = 0, g1 = 0, g2 = 0, squares = 0;
+      int coincident = 0;
+#pragma omp simd simdlen(8) reduction(+ : w, g0, g1, g2, squares) reduction(| : coincident)
+      for (int k = 0; k < count; ++k) {
+        const size_t j = neighbor[k];
+        const float r0 = pi[0] - p[Dim * j], r1 = pi[1] - p[Dim * j + 1];
+        const float r2 = Dim == 3 ? pi[Dim - 1] - p[Dim * j + Dim - 1] : 0.0f;
+        const float length2 = r0 * r0 + r1 * r1 + r2 * r2;
+        coincident |= length2 <= coincidentLength_ * coincidentLength_;
+        const auto pair = kernels_.pair(length2);
+        factors[k] = pair.gradientFactor;
+        w += pair.weight;
+        g0 += pair.gradientFactor * r0;
+        g1 += pair.gradientFactor * r1;
+        g2 += pair.gradientFactor * r2;
+        squares += pair.gradientFactor * pair.gradientFactor * length2;
+      }
+      if (!coincident) [[likely]] {
+        weight += w;
+        gradientSum[0] = g0;
+        gradientSum[1] = g1;
+        if constexpr (Dim == 3) gradientSum[2] = g2;
+        gradientSquaredSum = squares;
+      } else {
+        for (int k = 0; k < count; ++k) {
+          const VecD r = pairOffset(i, neighbor[k], pi);
+          const float r2 = r.squaredNorm();
+          const auto pair = kernels_.pair(r2);
+          factors[k] = pair.gradientFactor;
+          weight += pair.weight;
+          gradientSum += pair.gradientFactor * r;
+          gradientSquaredSum += pair.gradientFactor * pair.gradientFactor * r2;
+        }
       }
       VecD gradientI = massOverRho_ * gradientSum;
       gradientSquaredSum *= massOverRho_ * massOverRho_;
@@ -256,17 +290,54 @@ void PbfSolver<Dim>::applyPositionCorrections() {
       const float lambdaI = lambda_[i];
       if (sumLambdas) lambdaTotal_[i] += lambdaI;
       VecD delta = VecD::Zero();
-      const float* factor = pairGradientFactors_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
-      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++factor) {
-        VecD r = pi - p_[*j];
-        if (r.squaredNorm() <= coincidentLength_ * coincidentLength_) [[unlikely]] r = coincidentOffset(i, *j);
-        float coefficient = lambdaI + lambda_[*j];
-        if (scorr && coefficient == 0.0f) {
-          const float weight = kernels_.poly6(r.squaredNorm());
-          coefficient = -scorrScale * std::max(integerPower(weight * scorrInvWdq_, scorrN_) - scorrAtRest_, 0.0f);
+      const float* factors = pairGradientFactors_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
+      const uint32_t* neighbor = neighbors_.begin(i);
+      const int count = static_cast<int>(neighbors_.end(i) - neighbor);
+      // s_corr's coefficient for a pair at squared distance r2 (used where lambda_i + lambda_j = 0).
+      auto artificialPressure = [kernels = kernels_, scorrScale, inverse = scorrInvWdq_, n = scorrN_,
+                                 atRest = scorrAtRest_](float r2) {
+        const float excess = integerPower(kernels.poly6(r2) * inverse, n) - atRest;
+        return excess > 0.0f ? -scorrScale * excess : 0.0f;
+      };
+      // The pair's gradient factor: the lambda pass's, or evaluated here for the warm start.
+      auto gradientFactor = [&](int k, float r2) {
+        if constexpr (kWarmStart) return kernels_.pair(r2).gradientFactor;
+        else return factors[k];
+      };
+      // The vectorised loop (see the note at the top); a coincident pair sends the particle to the scalar loop after it.
+      const float* p = p_.data()->data();
+      const float* lambda = lambda_.data();
+      const float coincident2 = coincidentLength_ * coincidentLength_;
+      float d0 = 0, d1 = 0, d2 = 0;
+      int coincident = 0;
+#pragma omp simd simdlen(8) reduction(+ : d0, d1, d2) reduction(| : coincident)
+      for (int k = 0; k < count; ++k) {
+        const size_t j = neighbor[k];
+        const float r0 = pi[0] - p[Dim * j], r1 = pi[1] - p[Dim * j + 1];
+        const float r2 = Dim == 3 ? pi[Dim - 1] - p[Dim * j + Dim - 1] : 0.0f;
+        const float length2 = r0 * r0 + r1 * r1 + r2 * r2;
+        coincident |= length2 <= coincident2;
+        float coefficient = lambdaI + lambda[j];
+        // Evaluated for every pair and kept where lambda_i + lambda_j = 0 (zero with s_corr off, as its k is):
+        // a branch on `scorr` here stops the vectoriser.
+        const float pressure = artificialPressure(length2);
+        coefficient = coefficient == 0.0f ? pressure : coefficient;
+        const float scale = coefficient * gradientFactor(k, length2);
+        d0 += scale * r0;
+        d1 += scale * r1;
+        d2 += scale * r2;
+      }
+      if (!coincident) [[likely]] {
+        delta[0] = d0;
+        delta[1] = d1;
+        if constexpr (Dim == 3) delta[2] = d2;
+      } else {
+        for (int k = 0; k < count; ++k) {
+          const VecD r = pairOffset(i, neighbor[k], pi);
+          float coefficient = lambdaI + lambda_[neighbor[k]];
+          if (scorr && coefficient == 0.0f) coefficient = artificialPressure(r.squaredNorm());
+          delta += (coefficient * gradientFactor(k, r.squaredNorm())) * r;
         }
-        if constexpr (kWarmStart) delta += (coefficient * kernels_.pair(r.squaredNorm()).gradientFactor) * r;
-        else delta += (coefficient * *factor) * r;
       }
       // The walls do not move and carry no constraint of their own: only lambda_i acts along their gradient.
       float unusedWeight = 0;
@@ -376,6 +447,14 @@ void PbfSolver<Dim>::applyXsphViscosity() {
   });
   v_.swap(scratch_);
   times_.viscosity += millisecondsSince(start);
+}
+
+// p_i - p_j, or coincidentOffset for a pair closer than coincidentLength_.
+template <int Dim>
+typename PbfSolver<Dim>::VecD PbfSolver<Dim>::pairOffset(size_t i, size_t j, const VecD& pi) const {
+  const VecD r = pi - p_[j];
+  if (r.squaredNorm() <= coincidentLength_ * coincidentLength_) [[unlikely]] return coincidentOffset(i, j);
+  return r;
 }
 
 // Two particles on the same point (the walls project every particle that overshoots a corner onto the same

@@ -92,6 +92,7 @@ class PbfSolver final : public FluidSolver<Dim> {
   void applyXsphViscosity();
   // The offset p_i - p_j used for a pair closer than coincidentLength_ (see the .cpp).
   VecD coincidentOffset(size_t i, size_t j) const;
+  VecD pairOffset(size_t i, size_t j, const VecD& pi) const;  // p_i - p_j, or the offset above
   // Adds the walls' share of eq. 2 and eq. 8 for a particle at p: to the kernel weight sum and to
   // sum_j grad W (both before the factor m or m / rho_0).
   void addWallTerms(const VecD& p, float& weight, VecD& gradient) const;

@@ -91,6 +91,9 @@ class TankWalls {
     const float particleRadius = 0.5f * spacing;
     clampMin_ = domainMin + VecD::Constant(particleRadius);
     clampMax_ = domainMax - VecD::Constant(particleRadius);
+    // Beyond the kernel's support (with a margin over the tables' rounding) no wall reaches a particle.
+    interiorMin_ = domainMin + VecD::Constant(1.001f * support);
+    interiorMax_ = domainMax - VecD::Constant(1.001f * support);
     // A particle at distance d from a wall sees lattice layers at d + spacing / 2 + k spacing beyond it,
     // tangentially aligned with the particle. The walls' normals are taken along axes 0, 1, 2 here.
     const int reach = static_cast<int>(std::ceil(support / spacing)) + 1;
@@ -138,6 +141,7 @@ class TankWalls {
 
   // Adds the walls' share of sum_b W(p - p_b) to `weight` and of sum_b grad W(p - p_b) to `gradient`.
   void add(const VecD& p, float& weight, VecD& gradient) const {
+    if ((p.array() > interiorMin_.array()).all() && (p.array() < interiorMax_.array()).all()) return;
     for (int k = 0; k < Dim; ++k)
       for (int side = 0; side < 2; ++side) {
         const float d = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
@@ -322,7 +326,7 @@ class TankWalls {
   struct EdgeEntry {
     float weight = 0, gradientA = 0, gradientB = 0;  // gradients: magnitudes towards each wall
   };
-  VecD domainMin_, domainMax_, clampMin_, clampMax_;
+  VecD domainMin_, domainMax_, clampMin_, clampMax_, interiorMin_, interiorMax_;
   FlatWallTable flat_;
   std::vector<EdgeEntry> edge_;
   float edgeScale_ = 0;
