@@ -29,7 +29,7 @@ struct SolverSettings {
   double kernel_radius = 0;  // 0 in the file: 2 x particle_spacing (resolved on load)
   double rest_density = 1000;
   double relaxation_epsilon = 0.01;
-  double warm_start = 0.5;  // PBF: share of last step's lambda totals applied before the iterations; 0 turns it off
+  double warm_start = 0;  // PBF: share of last step's lambda sums applied before the iterations (experimental)
   double max_density_error = 0;  // > 0: iterate until the average density error is under it (DFSPH: 0 means 0.0005)
   double max_divergence_error = 0.001;  // DFSPH's divergence solver: average density change a step would cause
   int max_iterations = 100;             // DFSPH: the most iterations of each of its solvers a step

@@ -181,8 +181,9 @@ void visitScene(Scene& s, SceneVisitor& v) {
            atLeast(0, "PBF eq. 11 relaxation epsilon, as a fraction of the rest lattice's sum of squared "
                       "constraint gradients (0.01 softens the constraint by 1%)"));
     v.real("warm_start", s.solver.warm_start,
-           atLeast(0, "PBF: the share of the last step's lambda totals applied as one correction before the Jacobi "
-                      "iterations (a warm start, as DFSPH's); 0 turns it off", "", 0.9));
+           atLeast(0, "PBF, experimental: the share of the last step's lambda sums applied as one correction "
+                      "before the Jacobi iterations (a warm start, as DFSPH's); fewer iterations, but it adds "
+                      "kinetic energy to a deep 2D dam break (docs/speed-accuracy.md); 0 turns it off", "", 0.9));
     v.real("max_density_error", s.solver.max_density_error,
            atLeast(0, "PBF: when > 0, iterate until the average density error (a fraction) is under it, at most "
                       "`iterations` times; 0 runs exactly `iterations`. DFSPH: its density solver's limit on the "

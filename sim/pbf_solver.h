@@ -7,13 +7,13 @@
 //   updateVelocities        line 21     v = (x* - x) / dt
 //   vorticity + XSPH        line 22     vorticity confinement (eq. 15-16), XSPH viscosity (eq. 17)
 //   commit                  line 23     x = x*
-// The warm start (solver.warm_start, not in the paper): each particle's lambdas of a step are summed, and the
-// next step begins with one correction of eq. 12 by that share of the sums, as DFSPH warm-starts its pressure
-// (Bender & Koschier 2017, sec. 4.3). Fluid at rest then needs about half the correction each step, and a dam
-// break reaches the same density error in about half the iterations (docs/speed-accuracy.md). A particle found
-// uncompressed at any iteration forgets its sum: the constraint is one-sided, so a push that its neighbours no
-// longer resist is never taken back (without this a deep pool at 4 iterations boiled even at 0.5). The sums
-// are carried between frames (FluidSolver::carriedState), so a resumed run continues exactly.
+// The warm start (solver.warm_start, not in the paper; off by default, experimental): each particle's lambdas of
+// a step are summed, and the next step begins with one correction of eq. 12 by that share of the sums, as DFSPH
+// warm-starts its pressure (Bender & Koschier 2017, sec. 4.3). A particle found uncompressed at any iteration
+// forgets its sum. It halves the iterations of a 3D dam break at the same density error, but the constraint is
+// one-sided: a push beyond what the compression needed is never taken back and stays as velocity, and a deep 2D
+// dam break ends with three times the kinetic energy the other methods give it (docs/speed-accuracy.md). The
+// sums are carried between frames (FluidSolver::carriedState), so a resumed run continues exactly.
 // Every loop gathers over neighbours and writes only its own particle, so results do not depend on the thread
 // count. A feature the scene turns off (s_corr k = 0, vorticity epsilon = 0, XSPH c = 0) runs no pass and holds
 // no memory.

@@ -154,22 +154,31 @@ TEST(SimCommand, WcsphIsTheSameWithOneAndTwoThreadsAndResumesExactly) {
 
 // DFSPH through the same frame loop: its CFL steps, and its warm starts carried from frame to frame in
 // solver/frame_NNNNN.bin (the last two kept), so that a resumed run ends on the same bytes.
-TEST(SimCommand, DfsphIsTheSameWithOneAndTwoThreadsAndResumesExactly) {
+// Runs the small dam break with `settings` to frame 6 at 1 and 2 threads, and to frame 3 then resumed to 6:
+// the particle frames must be the same bytes, and the solver's state kept for the last two frames. Returns the
+// folders of the 1-thread run and the resumed one.
+std::pair<fs::path, fs::path> expectSameAtAnyThreadCountAndResumed(const std::string& settings, const std::string& tag) {
   const fs::path scene = writeTestScene("small.json", kSmallDamBreak);
-  const std::string dfsph = " --quiet --set solver.method=dfsph --set output.frames=6 --out ";
-  const fs::path one = freshFolder("surge_dfsph_1"), two = freshFolder("surge_dfsph_2"), resumed = freshFolder("surge_dfsph_r");
-  ASSERT_EQ(runSurge("sim '" + scene.string() + "' --threads 1" + dfsph + one.string()).status, 0);
-  ASSERT_EQ(runSurge("sim '" + scene.string() + "' --threads 2" + dfsph + two.string()).status, 0);
+  const std::string run = " --quiet " + settings + " --out ";
+  const fs::path one = freshFolder(tag + "_1"), two = freshFolder(tag + "_2"), resumed = freshFolder(tag + "_r");
+  EXPECT_EQ(runSurge("sim '" + scene.string() + "' --threads 1 --set output.frames=6" + run + one.string()).status, 0);
+  EXPECT_EQ(runSurge("sim '" + scene.string() + "' --threads 2 --set output.frames=6" + run + two.string()).status, 0);
   for (int f = 0; f <= 6; ++f)
     EXPECT_EQ(readTextFile(framePath(one, "particles", f, "ply")), readTextFile(framePath(two, "particles", f, "ply")))
-        << "frame " << f;
-  EXPECT_TRUE(fs::exists(framePath(one, "solver", 6, "bin")));
-  EXPECT_TRUE(fs::exists(framePath(one, "solver", 5, "bin")));
-  EXPECT_FALSE(fs::exists(framePath(one, "solver", 4, "bin")));
-  ASSERT_EQ(runSurge("sim '" + scene.string() + "' --quiet --set solver.method=dfsph --set output.frames=3 --out " +
-                     resumed.string()).status, 0);
-  ASSERT_EQ(runSurge("sim '" + scene.string() + "' --resume" + dfsph + resumed.string()).status, 0);
-  EXPECT_EQ(readTextFile(framePath(resumed, "particles", 6, "ply")), readTextFile(framePath(one, "particles", 6, "ply")));
+        << tag << " frame " << f;
+  EXPECT_TRUE(fs::exists(framePath(one, "solver", 6, "bin"))) << tag;
+  EXPECT_TRUE(fs::exists(framePath(one, "solver", 5, "bin"))) << tag;
+  EXPECT_FALSE(fs::exists(framePath(one, "solver", 4, "bin"))) << tag;
+  EXPECT_EQ(runSurge("sim '" + scene.string() + "' --set output.frames=3" + run + resumed.string()).status, 0);
+  EXPECT_EQ(runSurge("sim '" + scene.string() + "' --resume --set output.frames=6" + run + resumed.string()).status, 0);
+  EXPECT_EQ(readTextFile(framePath(resumed, "particles", 6, "ply")), readTextFile(framePath(one, "particles", 6, "ply")))
+      << tag;
+  return {one, resumed};
+}
+
+TEST(SimCommand, DfsphIsTheSameWithOneAndTwoThreadsAndResumesExactly) {
+  const fs::path scene = writeTestScene("small.json", kSmallDamBreak);
+  const auto [one, resumed] = expectSameAtAnyThreadCountAndResumed("--set solver.method=dfsph", "surge_dfsph");
   // Without the carried state the resumed run cannot be exact: it is refused in one line.
   fs::remove(framePath(resumed, "solver", 6, "bin"));
   const auto again = runSurge("sim '" + scene.string() + "' --resume --quiet --set solver.method=dfsph "
@@ -187,6 +196,16 @@ TEST(SimCommand, DfsphIsTheSameWithOneAndTwoThreadsAndResumesExactly) {
   EXPECT_GE(column("iterations"), 2.0);
   EXPECT_GE(column("divergence_iterations"), 1.0);
   EXPECT_GT(column("pressure_max"), 0.0);
+}
+
+// PBF with its warm start carries its lambda sums the same way: the same bytes at 1 and 2 threads and resumed.
+TEST(SimCommand, PbfWarmStartIsTheSameWithOneAndTwoThreadsAndResumesExactly) {
+  expectSameAtAnyThreadCountAndResumed("--set solver.warm_start=0.5", "surge_warm");
+  // Off (the default), PBF carries nothing.
+  const fs::path scene = writeTestScene("small.json", kSmallDamBreak);
+  const fs::path cold = freshFolder("surge_warm_off");
+  ASSERT_EQ(runSurge("sim '" + scene.string() + "' --quiet --set output.frames=2 --out " + cold.string()).status, 0);
+  EXPECT_FALSE(fs::exists(framePath(cold, "solver", 2, "bin")));
 }
 
 }  // namespace
