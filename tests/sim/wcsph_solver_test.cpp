@@ -5,6 +5,7 @@
 #include <map>
 
 #include "sim/simulation.h"
+#include "tests/sim/hydrostatic_column.h"
 
 namespace surge {
 namespace {
@@ -41,40 +42,12 @@ TEST(WcsphSolver, HydrostaticColumnHasHydrostaticPressureAndHoldsStill) {
   solver.setParticles(initialParticles(scene));
   simulateFor(solver, 3.0);
   ASSERT_FALSE(::testing::Test::HasFatalFailure());
-  std::map<int, std::pair<double, int>> layers;  // per layer one spacing thick: pressure sum, samples
-  float top = 0;
-  double speedSquaredSum = 0;
-  size_t speedSamples = 0;
+  ColumnSamples column;
   for (int sample = 0; sample < 20; ++sample) {
     simulateFor(solver, 1.0 / 30);
-    for (size_t i = 0; i < solver.size(); ++i) {
-      auto& layer = layers[static_cast<int>(solver.positions()[i].y() / 0.02f)];
-      layer.first += solver.pressures()[i];
-      layer.second += 1;
-      top = std::max(top, solver.positions()[i].y());
-      speedSquaredSum += solver.velocities()[i].squaredNorm();
-      ++speedSamples;
-    }
+    column.add(solver.positions(), solver.velocities(), solver.pressures());
   }
-  // Expected deviations from rho_0 g d (d below the surface, half a spacing above the top particle):
-  // (1) the surface is diffuse over one kernel support H = 0.04 m (particles there miss neighbours above and
-  // their pressure is clamped at 0), shifting pressures by up to rho_0 g H / 2 = 200 Pa; (2) weak
-  // compressibility: the column is compressed by g d / c^2 (0.01% at c = 44 m/s), negligible; (3) pressure
-  // noise, c^2 rho_0 times density fluctuations, averaged over 15 particles and 20 samples a layer. So each
-  // layer from 4 spacings below the surface down to the row above the floor must be within 10% + 200 Pa.
-  int checked = 0;
-  for (const auto& [index, sum] : layers) {
-    const double y = (index + 0.5) * 0.02, depth = top + 0.01 - y;
-    if (depth < 4 * 0.02 || index == 0 || sum.second < 100) continue;
-    const double expected = 1000 * 9.81 * depth, measured = sum.first / sum.second;
-    EXPECT_NEAR(measured, expected, 0.1 * expected + 200) << "layer at y = " << y;
-    ++checked;
-  }
-  EXPECT_GE(checked, 12);
-  // Holding still: the root-mean-square speed is under 3% of the speed of a fall through the column (0.084 m/s).
-  // (Single particles at the free surface keep hopping: a surface particle has no pressure, its neighbours
-  // below push it up, and it falls back; so the bound is on the bulk, not on the fastest particle.)
-  EXPECT_LT(std::sqrt(speedSquaredSum / speedSamples), 0.03 * std::sqrt(2 * 9.81 * 0.4));
+  expectHydrostaticColumn(column);
 }
 
 // The position of one particle orbiting the attractor (a smooth force field between its centre and radius:
