@@ -121,13 +121,14 @@ void BM_NeighborLists(benchmark::State& state) {
   grid.sort(x);
   gatherByOrder(grid.sortedOrder(), x, scratch);
   NeighborLists lists;
+  grid.findNeighbors(x, 0.02f, lists);  // warm-up: the lists keep their capacity, as in a run
   for (auto _ : state) {
     grid.findNeighbors(x, 0.02f, lists);
     benchmark::DoNotOptimize(lists.ends.data());
   }
   state.counters["neighbors/particle"] = double(lists.total()) / double(x.size());
 }
-BENCHMARK(BM_NeighborLists)->Args({0, 1})->Args({0, 2})->Args({1, 2})->ArgNames({"piled", "cells_per_radius"})->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+BENCHMARK(BM_NeighborLists)->Args({0, 1})->Args({0, 2})->Args({1, 1})->ArgNames({"piled", "cells_per_radius"})->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
 }  // namespace
 }  // namespace surge

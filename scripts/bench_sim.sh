@@ -32,13 +32,13 @@ awk -F, '
         n / 1000, threads, rate / 1e6, solver, bytes
     } else if (name ~ /GridRebuild/) {
       if (name ~ /piled:1/) piled = wall; else spread = wall
-    } else if (name ~ /NeighborLists\/piled:0\/cells_per_radius:2/) { listsSpread = wall
-    } else if (name ~ /NeighborLists\/piled:1\/cells_per_radius:2/) { listsPiled = wall
-    } else if (name ~ /NeighborLists\/piled:0\/cells_per_radius:1/) { listsCoarse = wall }
+    } else if (name ~ /NeighborLists\/piled:0\/cells_per_radius:1/) { listsSpread = wall
+    } else if (name ~ /NeighborLists\/piled:1\/cells_per_radius:1/) { listsPiled = wall
+    } else if (name ~ /NeighborLists\/piled:0\/cells_per_radius:2/) { listsFine = wall }
   }
   END {
     printf "| grid rebuild (sort + reorder), 1M spread | %.1f ms | < 100 ms | | |\n", spread
     printf "| grid rebuild, 1M piled in a corner of a 512x larger tank | %.1f ms (%.2fx spread) | no slower | | |\n", piled, piled / spread
-    printf "| neighbour lists, 1M spread, cells of h/2 | %.0f ms (cells of h: %.2fx) | | | |\n", listsSpread, listsCoarse / listsSpread
+    printf "| neighbour lists, 1M spread, cells of h | %.0f ms (cells of h/2: %.2fx) | | | |\n", listsSpread, listsFine / listsSpread
     printf "| neighbour lists, 1M piled | %.0f ms (%.2fx spread) | | | |\n", listsPiled, listsPiled / listsSpread
   }' "$csv" | { echo "| measure | measured | goal | bytes/particle | goal |"; echo "|---|---|---|---|---|"; cat; }

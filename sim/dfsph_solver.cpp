@@ -34,7 +34,7 @@ DfsphSolver<Dim>::DfsphSolver(const Scene& scene, std::shared_ptr<const Collider
       wendlandKernel_(static_cast<float>(scene.solver.kernel_radius)),
       attractor_(scene.attractor),
       grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
-            static_cast<float>(0.5 * scene.solver.kernel_radius)),
+            NeighborGrid<Dim>::cellSizeFor(static_cast<float>(scene.solver.kernel_radius))),
       walls_(makeSphTankWalls<Dim>(scene)) {
   if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
   sceneSpeedLimit_ = static_cast<float>(runawaySpeed(scene));

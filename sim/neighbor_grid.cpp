@@ -6,6 +6,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+
 #include "core/parallel.h"
 
 namespace surge {
@@ -20,6 +24,65 @@ constexpr uint64_t kDenseCellsAlways = 1 << 22;
 
 }  // namespace
 
+// kNeighborPadding and the two filters are declared in the header. The squared distance is summed in one fixed
+// order with fused multiply-adds on either path, so the lists are the same with and without AVX-512.
+template <int Dim>
+uint32_t* keepInRangeScalar(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i,
+                            uint32_t begin, uint32_t end, uint32_t* out) {
+  for (uint32_t j = begin; j < end; ++j) {
+    const float d0 = xi[0] - coordinates[j], d1 = xi[1] - coordinates[n + j];
+    float length2 = std::fma(d1, d1, d0 * d0);
+    if constexpr (Dim == 3) {
+      const float d2 = xi[2] - coordinates[2 * n + j];
+      length2 = std::fma(d2, d2, length2);
+    }
+    *out = j;
+    out += (length2 < r2) & (j != i);
+  }
+  return out;
+}
+
+template <int Dim>
+uint32_t* keepInRange(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i, uint32_t begin,
+                      uint32_t end, uint32_t* out) {
+#if defined(__AVX512F__)
+  // A stencil row holds a few dozen particles at most; a scalar loop over them mispredicts the end of almost
+  // every row, where 16 lanes take a row in one or two blocks.
+  const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const __m512 radius2 = _mm512_set1_ps(r2);
+  for (uint32_t j = begin; j < end; j += 16) {
+    const uint32_t count = std::min<uint32_t>(16, end - j);
+    const __mmask16 valid = static_cast<__mmask16>((1u << count) - 1u);
+    const __m512 d0 = _mm512_sub_ps(_mm512_set1_ps(xi[0]), _mm512_maskz_loadu_ps(valid, coordinates + j));
+    const __m512 d1 = _mm512_sub_ps(_mm512_set1_ps(xi[1]), _mm512_maskz_loadu_ps(valid, coordinates + n + j));
+    __m512 length2 = _mm512_fmadd_ps(d1, d1, _mm512_mul_ps(d0, d0));
+    if constexpr (Dim == 3) {
+      const __m512 d2 = _mm512_sub_ps(_mm512_set1_ps(xi[2]), _mm512_maskz_loadu_ps(valid, coordinates + 2 * n + j));
+      length2 = _mm512_fmadd_ps(d2, d2, length2);
+    }
+    const uint32_t self = i - j < 16 ? 1u << (i - j) : 0u;
+    const __mmask16 keep =
+        static_cast<__mmask16>(_mm512_mask_cmp_ps_mask(valid, length2, radius2, _CMP_LT_OQ) & ~self);
+    // Compressed in a register and stored whole: a compressing store to memory is slow on some CPUs.
+    const __m512i slots = _mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(j)), lane);
+    _mm512_storeu_si512(out, _mm512_maskz_compress_epi32(keep, slots));
+    out += __builtin_popcount(keep);
+  }
+  return out;
+#else
+  return keepInRangeScalar<Dim>(coordinates, n, xi, r2, i, begin, end, out);
+#endif
+}
+
+template <int Dim>
+float NeighborGrid<Dim>::cellSizeFor(float radius) {
+#if defined(__AVX512F__)
+  return radius;
+#else
+  return 0.5f * radius;
+#endif
+}
+
 template <int Dim>
 NeighborGrid<Dim>::NeighborGrid(const Vec<Dim>& domainMin, const Vec<Dim>& domainMax, float cellSize)
     : domainMin_(domainMin), domainMax_(domainMax), cellSize_(cellSize), inverseCellSize_(1.0f / cellSize) {}
@@ -27,12 +90,15 @@ NeighborGrid<Dim>::NeighborGrid(const Vec<Dim>& domainMin, const Vec<Dim>& domai
 template <int Dim>
 typename NeighborGrid<Dim>::Cell NeighborGrid<Dim>::cellCoordinates(const Vec<Dim>& p) const {
   Cell c;
-  for (int k = 0; k < Dim; ++k) {
-    const float x = (p[k] - origin_[k]) * inverseCellSize_;
-    // NaN and far-away positions land in the border cells; the solver reports them separately.
-    c[k] = x >= 0.0f ? std::min(static_cast<int64_t>(std::min(x, 4e18f)), resolution_[k] - 1) : 0;
-  }
+  // NaN and far-away positions land in the border cells; the solver reports them separately.
+  for (int k = 0; k < Dim; ++k) c[k] = cellAlong(p[k], k);
   return c;
+}
+
+template <int Dim>
+int64_t NeighborGrid<Dim>::cellAlong(float coordinate, int axis) const {
+  const float x = (coordinate - origin_[axis]) * inverseCellSize_;
+  return x >= 0.0f ? std::min(static_cast<int64_t>(std::min(x, 4e18f)), resolution_[axis] - 1) : 0;
 }
 
 template <int Dim>
@@ -152,16 +218,23 @@ void NeighborGrid<Dim>::slotsOfCells(uint64_t first, uint64_t last, uint32_t& be
 }
 
 template <int Dim>
-void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radius, NeighborLists& lists) const {
+void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radius, NeighborLists& lists) {
   const size_t n = x.size();
   const float r2 = radius * radius;
-  // Cells of half the radius are searched two cells out: fewer candidates than cells of the radius.
+  // Cells of half the radius are searched two cells out (see cellSizeFor).
   const int64_t reach = static_cast<int64_t>(std::ceil(radius / cellSize_ - 1e-4f));
   if (reach < 1 || reach > 2) throw std::invalid_argument("NeighborGrid: radius must be 1 or 2 cells");
   constexpr size_t kChunk = NeighborLists::kChunk;
   const size_t chunks = (n + kChunk - 1) / kChunk;
   lists.ends.resize(n);
   lists.chunks.resize(chunks);
+  // The positions as Dim arrays of floats (x of every particle, then y, ...) for the filter's vector loads.
+  coordinates_.resize(Dim * n);
+  float* coordinates = coordinates_.data();
+  parallelFor(0, n, [&](size_t b, size_t e) {
+    for (size_t j = b; j < e; ++j)
+      for (int k = 0; k < Dim; ++k) coordinates[k * n + j] = x[j][k];
+  });
   parallelFor(
       0, chunks,
       [&](size_t c0, size_t c1) {
@@ -191,21 +264,18 @@ void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radi
                 candidates += rowEnd[rows] - rowBegin[rows];
               }
             // Room for every candidate, then keep those in range: no capacity check per neighbour.
-            if (chunk.size() < used + candidates) {
+            if (chunk.size() < used + candidates + kNeighborPadding) {
               // Grow to what the whole chunk will likely need (the mean so far times the chunk, plus a tenth),
               // exactly: resize() alone would double.
               const size_t done = i - c * kChunk;  // particles of this chunk already listed
               const size_t expected = done ? used * kChunk / done : 0;
-              const size_t room = std::max(used, expected + expected / 10) + candidates;
+              const size_t room = std::max(used, expected + expected / 10) + candidates + kNeighborPadding;
               chunk.reserve(room);
               chunk.resize(room);
             }
             uint32_t* out = chunk.data() + used;
             for (int row = 0; row < rows; ++row)
-              for (uint32_t j = rowBegin[row]; j < rowEnd[row]; ++j) {
-                *out = j;
-                out += ((xi - x[j]).squaredNorm() < r2) & (j != i);
-              }
+              out = keepInRange<Dim>(coordinates, n, xi, r2, static_cast<uint32_t>(i), rowBegin[row], rowEnd[row], out);
             used = static_cast<size_t>(out - chunk.data());
             lists.ends[i] = static_cast<uint32_t>(used);
           }
@@ -225,6 +295,12 @@ void gatherByOrder(const std::vector<uint32_t>& order, std::vector<T>& values, s
 
 template class NeighborGrid<2>;
 template class NeighborGrid<3>;
+template uint32_t* keepInRange<2>(const float*, size_t, const Vec<2>&, float, uint32_t, uint32_t, uint32_t, uint32_t*);
+template uint32_t* keepInRange<3>(const float*, size_t, const Vec<3>&, float, uint32_t, uint32_t, uint32_t, uint32_t*);
+template uint32_t* keepInRangeScalar<2>(const float*, size_t, const Vec<2>&, float, uint32_t, uint32_t, uint32_t,
+                                        uint32_t*);
+template uint32_t* keepInRangeScalar<3>(const float*, size_t, const Vec<3>&, float, uint32_t, uint32_t, uint32_t,
+                                        uint32_t*);
 template void gatherByOrder(const std::vector<uint32_t>&, std::vector<Vec<2>>&, std::vector<Vec<2>>&);
 template void gatherByOrder(const std::vector<uint32_t>&, std::vector<Vec<3>>&, std::vector<Vec<3>>&);
 template void gatherByOrder(const std::vector<uint32_t>&, std::vector<uint32_t>&, std::vector<uint32_t>&);

@@ -62,6 +62,12 @@ void sizeForPairs(const NeighborLists& lists, std::vector<std::vector<T>>& perPa
 template <int Dim>
 class NeighborGrid {
  public:
+  // The cell size the solvers use for neighbours within `radius`. With AVX-512 the candidates are filtered 16 at
+  // a time, and a stencil of 3 x 3 rows of cells of the radius (two blocks of 16 a row) is quicker than one of
+  // 5 x 5 rows of cells of half of it (one block a row, but a row's set-up and its partial block cost as much).
+  // Filtered one at a time, cells of half the radius read fewer candidates and win (docs/performance.md).
+  static float cellSizeFor(float radius);
+
   // Cells of `cellSize`; positions outside [domainMin, domainMax] are clamped into the border cells.
   NeighborGrid(const Vec<Dim>& domainMin, const Vec<Dim>& domainMax, float cellSize);
 
@@ -72,13 +78,14 @@ class NeighborGrid {
 
   // For positions in the order of the last sort(): lists, for each particle, every other particle closer than
   // `radius` (one or two cell sizes), in increasing index order.
-  void findNeighbors(const std::vector<Vec<Dim>>& sortedPositions, float radius, NeighborLists& lists) const;
+  void findNeighbors(const std::vector<Vec<Dim>>& sortedPositions, float radius, NeighborLists& lists);
 
   // Cells of the last sort's box, and whether it used the sparse (sorted keys) path.
   uint64_t cellCount() const { return cellCount_; }
   size_t memoryBytes() const {
     return cellStart_.capacity() * 4 + cellKeys_.capacity() * 8 + sparseStart_.capacity() * 4 + rowStart_.capacity() * 4 +
-           cellOfParticle_.capacity() * 4 + keyOfParticle_.capacity() * 8 + order_.capacity() * 4;
+           cellOfParticle_.capacity() * 4 + keyOfParticle_.capacity() * 8 + order_.capacity() * 4 +
+           coordinates_.capacity() * 4;
   }
   bool sparse() const { return sparse_; }
   bool rowIndexed() const { return sparse_ && rowIndexed_; }
@@ -86,6 +93,8 @@ class NeighborGrid {
  private:
   using Cell = Eigen::Matrix<int64_t, Dim, 1>;
   Cell cellCoordinates(const Vec<Dim>& p) const;
+  // The cell along `axis` holding `coordinate`, clamped into the grid (NaN goes to cell 0).
+  int64_t cellAlong(float coordinate, int axis) const;
   uint64_t linearIndex(const Cell& c) const;
   // The sorted slots [begin, end) of the cells with linear indices [first, last].
   void slotsOfCells(uint64_t first, uint64_t last, uint32_t& begin, uint32_t& end) const;
@@ -104,7 +113,21 @@ class NeighborGrid {
   std::vector<uint32_t> cellOfParticle_;  // dense: each particle's cell
   std::vector<uint64_t> keyOfParticle_;   // sparse: each particle's 64-bit cell key
   std::vector<uint32_t> order_;
+  std::vector<float> coordinates_;  // findNeighbors: the positions as Dim arrays of floats
 };
+
+// The filter of findNeighbors: writes to `out`, in increasing order, the slots j in [begin, end) other than i
+// with |x_i - x_j|^2 < r2, reading positions stored as Dim arrays of n floats (all x, then all y, ...), and
+// returns the new end. It may write up to kNeighborPadding entries past that end. keepInRange uses AVX-512
+// when the build targets it (16 candidates at a time, compressed in a register) and is keepInRangeScalar
+// otherwise; the two give the same lists, which a test checks.
+constexpr size_t kNeighborPadding = 16;
+template <int Dim>
+uint32_t* keepInRange(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i, uint32_t begin,
+                      uint32_t end, uint32_t* out);
+template <int Dim>
+uint32_t* keepInRangeScalar(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i,
+                            uint32_t begin, uint32_t end, uint32_t* out);
 
 // Applies a permutation: values[k] = old values[order[k]], in parallel. Used to reorder every particle channel.
 template <typename T>

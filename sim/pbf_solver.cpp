@@ -33,9 +33,8 @@ template <int Dim>
 PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes)
     : kernels_(static_cast<float>(scene.solver.kernel_radius)),
       attractor_(scene.attractor),
-      // Cells of half the kernel radius: searching 5 cells a side reads fewer candidates than 3 of the radius.
       grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
-            static_cast<float>(0.5 * scene.solver.kernel_radius)),
+            NeighborGrid<Dim>::cellSizeFor(static_cast<float>(scene.solver.kernel_radius))),
       walls_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max), static_cast<float>(scene.particle_spacing),
              static_cast<float>(scene.solver.kernel_radius),
              [&](const VecD& r) { return kernels_.poly6(r.squaredNorm()); },

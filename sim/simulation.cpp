@@ -292,8 +292,12 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     bodyTable = std::make_unique<CsvFile>(dir / "bodies.csv", bodiesCsvHeader(), !fresh, summary.firstFrame);
   ParticleFrame frame;
   if (fresh) {
+    // Measured first: before the first step, measuring sorts the particles into cells, and frame 0 must hold
+    // them in the order the run goes on with, or a run resumed from it sorts a different order into the cells
+    // and sums its neighbours in another order.
+    const FluidMeasures measures = solver.measure();
     solver.getParticles(frame);
-    stats.add(statsRow(0, 0.0, solver.size(), 0, 0, solver.measure(), 0.0, PhaseTimes{}, 0.0, NAN,
+    stats.add(statsRow(0, 0.0, solver.size(), 0, 0, measures, 0.0, PhaseTimes{}, 0.0, NAN,
                        measureDamBreak(scene, frame), solver.lastDivergenceIterations() < 0 ? NAN : 0.0));
     if (bodies) {
       bodyTable->add(bodyRows(scene, 0, bodies->states(), std::vector<Wrench>(bodies->size())));

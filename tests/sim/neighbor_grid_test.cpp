@@ -125,6 +125,42 @@ TEST(NeighborGrid, SparsePathWithARowIndexMatchesBruteForce) {
   expectSameAsBruteForce<3>(x, Vec<3>(0, 0, 0), Vec<3>(40, 1, 1), 0.01f);
 }
 
+// The filter the search uses (AVX-512 where the build has it) keeps exactly what the scalar one keeps, over runs
+// of every length from 0 to 40 (partial, whole and several blocks of 16), with the particle itself inside,
+// first, last or outside the run, on a lattice whose spacing is half the radius, so that many pairs sit at the
+// radius to within rounding.
+template <int Dim>
+void expectFiltersAgree() {
+  const float h = 0.04f;
+  std::mt19937 random(9);
+  std::uniform_real_distribution<float> jitter(-1e-6f, 1e-6f);
+  const size_t n = 400;
+  std::vector<float> coordinates(Dim * n);
+  for (size_t j = 0; j < n; ++j)
+    for (int k = 0; k < Dim; ++k) coordinates[k * n + j] = 0.5f * h * float((j >> (3 * k)) % 8) + jitter(random);
+  size_t kept = 0;
+  for (uint32_t begin = 0; begin < 120; begin += 7)
+    for (uint32_t length = 0; length <= 40; ++length)
+      for (uint32_t i : {begin, begin + length / 2, begin + length - 1, begin + length + 3}) {
+        if (i >= n) continue;  // begin + length - 1 with begin = length = 0
+        Vec<Dim> xi;
+        for (int k = 0; k < Dim; ++k) xi[k] = coordinates[k * n + i];
+        std::vector<uint32_t> scalar(length + kNeighborPadding), vector(length + kNeighborPadding);
+        const auto scalarEnd = keepInRangeScalar<Dim>(coordinates.data(), n, xi, h * h, i, begin, begin + length, scalar.data());
+        const auto vectorEnd = keepInRange<Dim>(coordinates.data(), n, xi, h * h, i, begin, begin + length, vector.data());
+        scalar.resize(scalarEnd - scalar.data());
+        vector.resize(vectorEnd - vector.data());
+        ASSERT_EQ(vector, scalar) << "run " << begin << " + " << length << ", particle " << i;
+        kept += scalar.size();
+      }
+  EXPECT_GT(kept, 1000u);
+}
+
+TEST(NeighborGrid, VectorFilterKeepsWhatTheScalarOneKeeps) {
+  expectFiltersAgree<2>();
+  expectFiltersAgree<3>();
+}
+
 TEST(NeighborGrid, DenseGridCoversOnlyTheParticlesBox) {
   // A clump in the corner of a large tank costs cells for the clump only.
   std::mt19937 random(5);
