@@ -47,6 +47,8 @@ cpu() {  # user + system seconds
 }
 csv="$work/methods.csv"
 echo "run,cpu_seconds,wall_seconds,density_error_avg_percent" >"$csv"
+shares="$work/search_shares.txt"
+: >"$shares"
 
 peer() {  # peer METHOD LABEL
   local run="$work/sph_$1"
@@ -72,18 +74,20 @@ ours() {  # ours METHOD LABEL
   local run="$work/surge_$1"
   /usr/bin/time -v "$surge" sim "$work/surge_dam_break.json" --quiet --set solver.method="$1" --out "$run" \
     >"$run.out" 2>&1
-  awk -F, -v label="$2" -v wall="$(seconds "$run.out")" -v cpu="$(cpu "$run.out")" -v csv="$csv" '
+  awk -F, -v label="$2" -v wall="$(seconds "$run.out")" -v cpu="$(cpu "$run.out")" -v csv="$csv" -v shares="$shares" '
     NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next }
     $1 > 0 {
       n = $col["particles"]; s = $col["substeps"]; steps += s; it += s * $col["iterations"]
       if (col["divergence_iterations"] && $col["divergence_iterations"] != "") itv += s * $col["divergence_iterations"]
       err += $col["density_error_avg"]; frames++
+      search += $col["ms_neighbors"] / 1000; simulated += $col["wall_seconds"]
     }
     END {
       iters = itv == 0 ? sprintf("%.2f", it / steps) : sprintf("%.2f + %.2f divergence", it / steps, itv / steps)
       if (it == 0) iters = "none"
       printf "| %s | %d | %d | %.1f s | %.1f s | %.2f us | %s | %.3f%% |\n", label, n, steps, wall, cpu, 1e6 * wall / (n * steps), iters, 100 * err / frames
       printf "%s,%.2f,%.2f,%.4f\n", label, cpu, wall, 100 * err / frames >> csv
+      printf "- %s: the neighbour search (sort, reorder, lists) took %.1f s of %.1f s simulating, %.1f%%\n", label, search, simulated, 100 * search / simulated >> shares
     }' "$run/stats.csv"
 }
 
@@ -98,6 +102,8 @@ for ((r = 0; r < repeats; ++r)); do
   ours dfsph "Surge DFSPH"
 done
 ours wcsph "Surge WCSPH"
+echo
+cat "$shares"
 
 if command -v gnuplot >/dev/null; then
   gnuplot -e "csv='$csv'; png='$work/methods_error_vs_cpu.png'" "$(dirname "$0")/plot_methods.gp"

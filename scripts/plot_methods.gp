@@ -4,7 +4,7 @@ set terminal pngcairo size 820,460 noenhanced font ",11"
 set output png
 set datafile separator ","
 set logscale x
-set xrange [40:1600]
+set xrange [10:1600]
 set yrange [0.02:0.06]
 set xlabel "CPU seconds for 1 s of the dam break (2 cores, one run at a time)"
 set ylabel "average density error, %"
@@ -13,4 +13,4 @@ set key off
 surge(name) = strstrt(name, "Surge") == 1
 plot csv every ::1 using ($2):(surge(strcol(1)) ? $4 : 1/0) with points pointtype 7 pointsize 1.6 lc rgb "#1f5fbf", \
      csv every ::1 using ($2):(surge(strcol(1)) ? 1/0 : $4) with points pointtype 5 pointsize 1.5 lc rgb "#c03020", \
-     csv every ::1 using 2:4:1 with labels left offset char 1.2,0
+     csv every ::1 using 2:4:1 with labels center offset char 0,1.1
