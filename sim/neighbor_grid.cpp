@@ -6,7 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#if defined(__AVX512F__)
+#if defined(__AVX2__) || defined(__AVX512F__)
 #include <immintrin.h>
 #endif
 
@@ -24,8 +24,8 @@ constexpr uint64_t kDenseCellsAlways = 1 << 22;
 
 }  // namespace
 
-// kNeighborPadding and the two filters are declared in the header. The squared distance is summed in one fixed
-// order with fused multiply-adds on either path, so the lists are the same with and without AVX-512.
+// kNeighborPadding and the filters are declared in the header. The squared distance is summed in one fixed
+// order with fused multiply-adds on every path, so the lists are the same whichever a build uses.
 template <int Dim>
 uint32_t* keepInRangeScalar(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i,
                             uint32_t begin, uint32_t end, uint32_t* out) {
@@ -42,12 +42,12 @@ uint32_t* keepInRangeScalar(const float* coordinates, size_t n, const Vec<Dim>& 
   return out;
 }
 
-template <int Dim>
-uint32_t* keepInRange(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i, uint32_t begin,
-                      uint32_t end, uint32_t* out) {
+// A stencil row holds a few dozen particles at most; a scalar loop over them mispredicts the end of almost every
+// row, where vector lanes take a row in a block or two.
 #if defined(__AVX512F__)
-  // A stencil row holds a few dozen particles at most; a scalar loop over them mispredicts the end of almost
-  // every row, where 16 lanes take a row in one or two blocks.
+template <int Dim>
+uint32_t* keepInRangeAvx512(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i,
+                            uint32_t begin, uint32_t end, uint32_t* out) {
   const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   const __m512 radius2 = _mm512_set1_ps(r2);
   for (uint32_t j = begin; j < end; j += 16) {
@@ -69,6 +69,59 @@ uint32_t* keepInRange(const float* coordinates, size_t n, const Vec<Dim>& xi, fl
     out += __builtin_popcount(keep);
   }
   return out;
+}
+#endif
+
+#if defined(__AVX2__) && defined(__FMA__)
+namespace {
+// For each 8-bit mask of kept lanes, the lanes in order, packed to the front (AVX2 has no compress).
+struct CompressTable {
+  uint8_t lanes[256][8] = {};
+  constexpr CompressTable() {
+    for (int mask = 0; mask < 256; ++mask) {
+      int k = 0;
+      for (int lane = 0; lane < 8; ++lane)
+        if (mask & (1 << lane)) lanes[mask][k++] = static_cast<uint8_t>(lane);
+    }
+  }
+};
+constexpr CompressTable kCompressTable;
+}  // namespace
+
+template <int Dim>
+uint32_t* keepInRangeAvx2(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i,
+                          uint32_t begin, uint32_t end, uint32_t* out) {
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256 radius2 = _mm256_set1_ps(r2);
+  for (uint32_t j = begin; j < end; j += 8) {
+    const int count = static_cast<int>(std::min<uint32_t>(8, end - j));
+    const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(count), lane);  // masked loads do not fault
+    const __m256 d0 = _mm256_sub_ps(_mm256_set1_ps(xi[0]), _mm256_maskload_ps(coordinates + j, valid));
+    const __m256 d1 = _mm256_sub_ps(_mm256_set1_ps(xi[1]), _mm256_maskload_ps(coordinates + n + j, valid));
+    __m256 length2 = _mm256_fmadd_ps(d1, d1, _mm256_mul_ps(d0, d0));
+    if constexpr (Dim == 3) {
+      const __m256 d2 = _mm256_sub_ps(_mm256_set1_ps(xi[2]), _mm256_maskload_ps(coordinates + 2 * n + j, valid));
+      length2 = _mm256_fmadd_ps(d2, d2, length2);
+    }
+    const uint32_t self = i - j < 8 ? 1u << (i - j) : 0u;
+    const uint32_t keep = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(length2, radius2, _CMP_LT_OQ))) &
+                          ((1u << count) - 1u) & ~self;
+    const __m256i order = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(kCompressTable.lanes[keep])));
+    const __m256i slots = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(j)), lane);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_permutevar8x32_epi32(slots, order));
+    out += __builtin_popcount(keep);
+  }
+  return out;
+}
+#endif
+
+template <int Dim>
+uint32_t* keepInRange(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i, uint32_t begin,
+                      uint32_t end, uint32_t* out) {
+#if defined(__AVX512F__)
+  return keepInRangeAvx512<Dim>(coordinates, n, xi, r2, i, begin, end, out);
+#elif defined(__AVX2__) && defined(__FMA__)
+  return keepInRangeAvx2<Dim>(coordinates, n, xi, r2, i, begin, end, out);
 #else
   return keepInRangeScalar<Dim>(coordinates, n, xi, r2, i, begin, end, out);
 #endif
@@ -76,7 +129,7 @@ uint32_t* keepInRange(const float* coordinates, size_t n, const Vec<Dim>& xi, fl
 
 template <int Dim>
 float NeighborGrid<Dim>::cellSizeFor(float radius) {
-#if defined(__AVX512F__)
+#if defined(__AVX512F__) || (defined(__AVX2__) && defined(__FMA__))
   return radius;
 #else
   return 0.5f * radius;
@@ -301,6 +354,18 @@ template uint32_t* keepInRangeScalar<2>(const float*, size_t, const Vec<2>&, flo
                                         uint32_t*);
 template uint32_t* keepInRangeScalar<3>(const float*, size_t, const Vec<3>&, float, uint32_t, uint32_t, uint32_t,
                                         uint32_t*);
+#if defined(__AVX512F__)
+template uint32_t* keepInRangeAvx512<2>(const float*, size_t, const Vec<2>&, float, uint32_t, uint32_t, uint32_t,
+                                        uint32_t*);
+template uint32_t* keepInRangeAvx512<3>(const float*, size_t, const Vec<3>&, float, uint32_t, uint32_t, uint32_t,
+                                        uint32_t*);
+#endif
+#if defined(__AVX2__) && defined(__FMA__)
+template uint32_t* keepInRangeAvx2<2>(const float*, size_t, const Vec<2>&, float, uint32_t, uint32_t, uint32_t,
+                                      uint32_t*);
+template uint32_t* keepInRangeAvx2<3>(const float*, size_t, const Vec<3>&, float, uint32_t, uint32_t, uint32_t,
+                                      uint32_t*);
+#endif
 template void gatherByOrder(const std::vector<uint32_t>&, std::vector<Vec<2>>&, std::vector<Vec<2>>&);
 template void gatherByOrder(const std::vector<uint32_t>&, std::vector<Vec<3>>&, std::vector<Vec<3>>&);
 template void gatherByOrder(const std::vector<uint32_t>&, std::vector<uint32_t>&, std::vector<uint32_t>&);

@@ -62,9 +62,9 @@ void sizeForPairs(const NeighborLists& lists, std::vector<std::vector<T>>& perPa
 template <int Dim>
 class NeighborGrid {
  public:
-  // The cell size the solvers use for neighbours within `radius`. With AVX-512 the candidates are filtered 16 at
-  // a time, and a stencil of 3 x 3 rows of cells of the radius (two blocks of 16 a row) is quicker than one of
-  // 5 x 5 rows of cells of half of it (one block a row, but a row's set-up and its partial block cost as much).
+  // The cell size the solvers use for neighbours within `radius`. With a vector filter (AVX-512 or AVX2, see
+  // keepInRange) a stencil of 3 x 3 rows of cells of the radius (a block or few a row) is quicker than one of
+  // 5 x 5 rows of cells of half of it (a row's set-up and its partial block cost as much as a full one).
   // Filtered one at a time, cells of half the radius read fewer candidates and win (docs/performance.md).
   static float cellSizeFor(float radius);
 
@@ -118,9 +118,9 @@ class NeighborGrid {
 
 // The filter of findNeighbors: writes to `out`, in increasing order, the slots j in [begin, end) other than i
 // with |x_i - x_j|^2 < r2, reading positions stored as Dim arrays of n floats (all x, then all y, ...), and
-// returns the new end. It may write up to kNeighborPadding entries past that end. keepInRange uses AVX-512
-// when the build targets it (16 candidates at a time, compressed in a register) and is keepInRangeScalar
-// otherwise; the two give the same lists, which a test checks.
+// returns the new end. It may write up to kNeighborPadding entries past that end. keepInRange is the widest
+// the build targets: AVX-512 (16 candidates at a time, compressed in a register), else AVX2 with FMA (8 at a
+// time, packed by a table of lane orders), else keepInRangeScalar. All give the same lists, which a test checks.
 constexpr size_t kNeighborPadding = 16;
 template <int Dim>
 uint32_t* keepInRange(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i, uint32_t begin,
@@ -128,6 +128,16 @@ uint32_t* keepInRange(const float* coordinates, size_t n, const Vec<Dim>& xi, fl
 template <int Dim>
 uint32_t* keepInRangeScalar(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i,
                             uint32_t begin, uint32_t end, uint32_t* out);
+#if defined(__AVX512F__)
+template <int Dim>
+uint32_t* keepInRangeAvx512(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i,
+                            uint32_t begin, uint32_t end, uint32_t* out);
+#endif
+#if defined(__AVX2__) && defined(__FMA__)
+template <int Dim>
+uint32_t* keepInRangeAvx2(const float* coordinates, size_t n, const Vec<Dim>& xi, float r2, uint32_t i,
+                          uint32_t begin, uint32_t end, uint32_t* out);
+#endif
 
 // Applies a permutation: values[k] = old values[order[k]], in parallel. Used to reorder every particle channel.
 template <typename T>

@@ -125,7 +125,7 @@ TEST(NeighborGrid, SparsePathWithARowIndexMatchesBruteForce) {
   expectSameAsBruteForce<3>(x, Vec<3>(0, 0, 0), Vec<3>(40, 1, 1), 0.01f);
 }
 
-// The filter the search uses (AVX-512 where the build has it) keeps exactly what the scalar one keeps, over runs
+// Every vector filter the build has (keepInRange is the widest of them) keeps exactly what the scalar one keeps, over runs
 // of every length from 0 to 40 (partial, whole and several blocks of 16), with the particle itself inside,
 // first, last or outside the run, on a lattice whose spacing is half the radius, so that many pairs sit at the
 // radius to within rounding.
@@ -145,12 +145,19 @@ void expectFiltersAgree() {
         if (i >= n) continue;  // begin + length - 1 with begin = length = 0
         Vec<Dim> xi;
         for (int k = 0; k < Dim; ++k) xi[k] = coordinates[k * n + i];
-        std::vector<uint32_t> scalar(length + kNeighborPadding), vector(length + kNeighborPadding);
-        const auto scalarEnd = keepInRangeScalar<Dim>(coordinates.data(), n, xi, h * h, i, begin, begin + length, scalar.data());
-        const auto vectorEnd = keepInRange<Dim>(coordinates.data(), n, xi, h * h, i, begin, begin + length, vector.data());
-        scalar.resize(scalarEnd - scalar.data());
-        vector.resize(vectorEnd - vector.data());
-        ASSERT_EQ(vector, scalar) << "run " << begin << " + " << length << ", particle " << i;
+        auto keep = [&](auto filter) {
+          std::vector<uint32_t> slots(length + kNeighborPadding);
+          slots.resize(filter(coordinates.data(), n, xi, h * h, i, begin, begin + length, slots.data()) - slots.data());
+          return slots;
+        };
+        const std::vector<uint32_t> scalar = keep(keepInRangeScalar<Dim>);
+        ASSERT_EQ(keep(keepInRange<Dim>), scalar) << "run " << begin << " + " << length << ", particle " << i;
+#if defined(__AVX512F__)
+        ASSERT_EQ(keep(keepInRangeAvx512<Dim>), scalar) << "AVX-512, run " << begin << " + " << length << ", particle " << i;
+#endif
+#if defined(__AVX2__) && defined(__FMA__)
+        ASSERT_EQ(keep(keepInRangeAvx2<Dim>), scalar) << "AVX2, run " << begin << " + " << length << ", particle " << i;
+#endif
         kept += scalar.size();
       }
   EXPECT_GT(kept, 1000u);
