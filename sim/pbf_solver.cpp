@@ -174,7 +174,6 @@ void PbfSolver<Dim>::solveDensityConstraints() {
   if (warmStart_ > 0) applyWarmStart();
   for (int iteration = 0; iteration < iterations_; ++iteration) {
     const double averageError = computeLambdas();
-    if (iteration == 0 && !colliders_.empty()) applyColliderHydrostaticPressure();
     if (maxDensityError_ > 0 && averageError <= maxDensityError_) break;
     applyPositionCorrections<false>();
     ++lastIterations_;
@@ -363,34 +362,6 @@ void PbfSolver<Dim>::applyPositionCorrections() {
       p_[i] += scratch_[i];
       if (!colliders_.empty()) collide(i, before, false);
       else walls_.clamp(p_[i]);
-    }
-  });
-}
-
-// The colliders' pressure continued hydrostatically from the particle's (Adami, Hu and Adams 2012, eq. 27, as
-// WCSPH's colliders have it): eq. 12's wall term lets only lambda_i act, as if the wall held the particle's own
-// pressure at every depth; a wall below the particle holds more, one above less, by rho_0 g . (x_b - x_i). With
-// lambda = -dt^2 p / rho_0, that difference moves the particle by
-//   delta p_i = -(m / rho_0) dt^2 sum_b (g . (x_b - x_i)) grad W(p_i - p_b)   (Colliders::hydrostaticSum),
-// once a step, for the particles compressed at the step's first iteration (where the water has a pressure to
-// continue; at the free surface it has none). Each collider's part is an impulse it gives the particle. A floating
-// box's 3D drafts went from -3.7% / -3.1% of its height to -2.9% / -2.7%, and a box on the floor from carrying
-// 5.0% less than its column to 3.3% less (docs/bodies.md). The tank's walls keep the particle's pressure, so a
-// scene without colliders runs as before.
-template <int Dim>
-void PbfSolver<Dim>::applyColliderHydrostaticPressure() {
-  const float scale = -massOverRho_ * stepDt_ * stepDt_;
-  parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      if (!(lambda_[i] < 0.0f)) continue;
-      const VecD pi = p_[i];
-      VecD delta = VecD::Zero();
-      colliders_.forEachNear(pi, [&](size_t c, float d, const VecD& n) {
-        const VecD move = scale * colliders_.hydrostaticSum(d, n, gravity_);
-        delta += move;
-        colliders_.addImpulse(i, c, (mass_ / stepDt_) * move, pi);
-      });
-      p_[i] += delta;
     }
   });
 }

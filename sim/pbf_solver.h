@@ -86,7 +86,6 @@ class PbfSolver final : public FluidSolver<Dim> {
   void applyPositionCorrections();
   void updateVelocities(float dt);
   void collide(size_t i, const VecD& from, bool fromStepStart);
-  void applyColliderHydrostaticPressure();
   VecD colliderCorrection(size_t i, const VecD& p, float lambda);
   void applyFriction();
   void applyVorticityConfinement(float dt);

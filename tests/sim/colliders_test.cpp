@@ -236,12 +236,10 @@ Wrench meanWrench(Solver& solver, const Scene& scene, double seconds, double& ti
 
 // A box on the floor under a column of water carries the column's weight: the force on its top face is the
 // weight of the particles above that face (their mass times g, which holds whatever PBF's compression), and
-// its sides' pressures cancel. Over 1 s after 1.5 s of settling, within 4.5%: the flat-wall model loses part of
-// the load at the top face's rim to the floor beside it (docs/colliders.md). With the wall's pressure taken as
-// the particle's at every depth this box read -4.8% and -5.0% (two builds whose sums differ in the last bits);
-// continued hydrostatically (PbfSolver::applyColliderHydrostaticPressure), -3.3%. Sideways forces within 2% of
-// the weight; the torque about its centre vanishes by symmetry (within 2% of the weight times the box's
-// half-width).
+// its sides' pressures cancel. Over 1 s after 1.5 s of settling, within 6%: the flat-wall model loses 6-7 N per
+// metre of the top face's rim to the floor beside it (measured on boxes 0.1 and 0.2 m wide: -8.8% and -4.8%,
+// docs/colliders.md), 4.8% of this 0.2 m box. Sideways forces within 2% of the weight; the torque about its
+// centre vanishes by symmetry (within 2% of the weight times the box's half-width).
 TEST(Colliders, BoxOnTheFloorCarriesTheWaterAboveIt) {
   const Scene scene = makeScene(3, R"({"min": [0, 0, 0], "max": [0.4, 0.6, 0.4]})",
                                 R"([{"box": {"min": [0, 0, 0], "max": [0.4, 0.4, 0.4]}}])",
@@ -255,7 +253,7 @@ TEST(Colliders, BoxOnTheFloorCarriesTheWaterAboveIt) {
   for (const Eigen::Vector3f& p : solver.positions())
     above += p.y() > 0.1f && std::abs(p.x() - 0.2f) < 0.1f && std::abs(p.z() - 0.2f) < 0.1f;
   const double weight = above * solver.particleMass() * 9.81;
-  EXPECT_NEAR(-w.force.y(), weight, 0.045 * weight);
+  EXPECT_NEAR(-w.force.y(), weight, 0.06 * weight);
   EXPECT_NEAR(w.force.x(), 0.0, 0.02 * weight);
   EXPECT_NEAR(w.force.z(), 0.0, 0.02 * weight);
   EXPECT_LT(w.torque.norm(), 0.02 * weight * 0.05);
