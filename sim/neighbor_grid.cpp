@@ -143,15 +143,12 @@ NeighborGrid<Dim>::NeighborGrid(const Vec<Dim>& domainMin, const Vec<Dim>& domai
 template <int Dim>
 typename NeighborGrid<Dim>::Cell NeighborGrid<Dim>::cellCoordinates(const Vec<Dim>& p) const {
   Cell c;
-  // NaN and far-away positions land in the border cells; the solver reports them separately.
-  for (int k = 0; k < Dim; ++k) c[k] = cellAlong(p[k], k);
+  for (int k = 0; k < Dim; ++k) {
+    const float x = (p[k] - origin_[k]) * inverseCellSize_;
+    // NaN and far-away positions land in the border cells; the solver reports them separately.
+    c[k] = x >= 0.0f ? std::min(static_cast<int64_t>(std::min(x, 4e18f)), resolution_[k] - 1) : 0;
+  }
   return c;
-}
-
-template <int Dim>
-int64_t NeighborGrid<Dim>::cellAlong(float coordinate, int axis) const {
-  const float x = (coordinate - origin_[axis]) * inverseCellSize_;
-  return x >= 0.0f ? std::min(static_cast<int64_t>(std::min(x, 4e18f)), resolution_[axis] - 1) : 0;
 }
 
 template <int Dim>
@@ -274,7 +271,7 @@ template <int Dim>
 void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radius, NeighborLists& lists) {
   const size_t n = x.size();
   const float r2 = radius * radius;
-  // Cells of half the radius are searched two cells out (see cellSizeFor).
+  // Cells of the radius are searched one cell out, cells of half of it two (see cellSizeFor).
   const int64_t reach = static_cast<int64_t>(std::ceil(radius / cellSize_ - 1e-4f));
   if (reach < 1 || reach > 2) throw std::invalid_argument("NeighborGrid: radius must be 1 or 2 cells");
   constexpr size_t kChunk = NeighborLists::kChunk;

@@ -93,8 +93,6 @@ class NeighborGrid {
  private:
   using Cell = Eigen::Matrix<int64_t, Dim, 1>;
   Cell cellCoordinates(const Vec<Dim>& p) const;
-  // The cell along `axis` holding `coordinate`, clamped into the grid (NaN goes to cell 0).
-  int64_t cellAlong(float coordinate, int axis) const;
   uint64_t linearIndex(const Cell& c) const;
   // The sorted slots [begin, end) of the cells with linear indices [first, last].
   void slotsOfCells(uint64_t first, uint64_t last, uint32_t& begin, uint32_t& end) const;

@@ -25,8 +25,6 @@ inline float integerPower(float x, int n) {
 // may differ in the last bits), never on the thread count. A pair closer than coincidentLength_ (see
 // coincidentOffset) is rare; its particle is done again by the scalar loop beside.
 
-
-
 }  // namespace
 
 template <int Dim>
@@ -178,7 +176,6 @@ void PbfSolver<Dim>::solveDensityConstraints() {
     applyPositionCorrections<false>();
     ++lastIterations_;
   }
-
   times_.constraint += millisecondsSince(start);
 }
 
