@@ -30,6 +30,7 @@ struct SolverSettings {
   double rest_density = 1000;
   double relaxation_epsilon = 0.01;
   double warm_start = 0;  // PBF: share of last step's lambda sums applied before the iterations (experimental)
+  double chebyshev_rho = 0.85;  // PBF to max_density_error: the spectral radius its Chebyshev acceleration assumes
   double max_density_error = 0;  // > 0: iterate until the average density error is under it (DFSPH: 0 means 0.0005)
   double max_divergence_error = 0.001;  // DFSPH's divergence solver: average density change a step would cause
   int max_iterations = 100;             // DFSPH: the most iterations of each of its solvers a step

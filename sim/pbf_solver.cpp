@@ -64,6 +64,8 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
   vorticityEpsilon_ = static_cast<float>(s.vorticity_epsilon);
   xsphC_ = static_cast<float>(s.xsph_c);
   warmStart_ = static_cast<float>(s.warm_start);
+  // The acceleration only when iterating to a tolerance (see solveDensityConstraints).
+  chebyshevRho_ = s.max_density_error > 0 ? static_cast<float>(s.chebyshev_rho) : 0.0f;
   iterations_ = s.iterations;
   maxDensityError_ = s.max_density_error;
   gravity_ = toVec<Dim>(scene.gravity);
@@ -165,12 +167,31 @@ void PbfSolver<Dim>::findNeighbors() {
 
 // Lines 8-19: Jacobi iterations on the density constraints. With solver.max_density_error > 0 the loop stops
 // early once the average density error is under it; solver.iterations caps it either way.
+// The Chebyshev semi-iterative acceleration (Wang 2015, "A Chebyshev Semi-Iterative Approach for Accelerating
+// Projective and Position-based Dynamics", eq. 12) weights iteration k by
+//   omega_1 = 1, omega_2 = 2 / (2 - rho^2), omega_k+1 = 4 / (4 - rho^2 omega_k),
+// rho being solver.chebyshev_rho, the spectral radius it assumes for the Jacobi iterations. The paper
+// extrapolates positions; here the extrapolation is of the step's summed multipliers Lambda (Lambda_k+1 =
+// omega (Lambda_k + lambda_k - Lambda_k-1) + Lambda_k-1), so the multiplier an iteration applies in eq. 12 is
+//   mu_k = omega_k lambda_k + (omega_k - 1) mu_k-1,
+// and it is kept only while the particle's constraint is active: a particle no longer compressed gets no push
+// from the momentum of earlier ones (computeLambdas). Extrapolating positions, as the paper does, kept moving
+// such particles, and a 2D dam break gained energy (docs/speed-accuracy.md).
+// It runs only when the loop iterates to solver.max_density_error. After a fixed handful of iterations its
+// polynomial leaves up to 1 / T_k(1 / rho) of the most local errors (19% at 4 iterations, rho = 0.85), which one
+// plain Jacobi iteration clears: a deep pool at the default 4 iterations stirred itself to 0.14 m/s RMS, against
+// 0.03 m/s without it.
 template <int Dim>
 void PbfSolver<Dim>::solveDensityConstraints() {
   const auto start = PhaseClock::now();
   lastIterations_ = 0;
   if (warmStart_ > 0) applyWarmStart();
+  if (chebyshevRho_ > 0) appliedLambda_.assign(size(), 0.0f);
+  const float rho2 = chebyshevRho_ * chebyshevRho_;
   for (int iteration = 0; iteration < iterations_; ++iteration) {
+    chebyshevOmega_ = iteration == 0 ? 1.0f
+                      : iteration == 1 ? 2.0f / (2.0f - rho2)
+                                       : 4.0f / (4.0f - rho2 * chebyshevOmega_);
     const double averageError = computeLambdas();
     if (maxDensityError_ > 0 && averageError <= maxDensityError_) break;
     applyPositionCorrections<false>();
@@ -262,6 +283,12 @@ double PbfSolver<Dim>::computeLambdas() {
       }
       const float constraint = std::max(mass_ * weight / restDensity_ - 1.0f, 0.0f);
       lambda_[i] = -constraint / (gradientSquaredSum + gradientI.squaredNorm() + epsilon_);
+      if (!appliedLambda_.empty()) {  // the Chebyshev acceleration (see solveDensityConstraints)
+        // != 0 rather than > 0: a NaN constraint passes its NaN on, so that a blow-up still shows.
+        const float mu = constraint != 0.0f ? chebyshevOmega_ * lambda_[i] + (chebyshevOmega_ - 1.0f) * appliedLambda_[i]
+                                            : 0.0f;
+        lambda_[i] = appliedLambda_[i] = mu;
+      }
       // The warm start's sums forget a particle that is not compressed (see the header).
       if (constraint == 0.0f && !lambdaTotal_.empty()) lambdaTotal_[i] = 0.0f;
       errorSum += constraint;
@@ -494,7 +521,8 @@ template <int Dim>
 size_t PbfSolver<Dim>::memoryBytes() const {
   size_t bytes = (x_.capacity() + v_.capacity() + p_.capacity() + scratch_.capacity() + omega3_.capacity()) * sizeof(VecD);
   bytes += (id_.capacity() + scratchIds_.capacity()) * sizeof(uint32_t);
-  bytes += (lambda_.capacity() + lambdaTotal_.capacity() + scratchFloats_.capacity() + omega2_.capacity()) *
+  bytes += (lambda_.capacity() + lambdaTotal_.capacity() + appliedLambda_.capacity() + scratchFloats_.capacity() +
+            omega2_.capacity()) *
            sizeof(float);
   for (const auto& factors : pairGradientFactors_) bytes += factors.capacity() * sizeof(float);
   return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes();

@@ -3,7 +3,8 @@
 //   predictPositions        lines 1-4   apply external forces, predict x*
 //   findNeighbors           lines 5-7   sort into the grid, reorder particles, build neighbour lists
 //   solveDensityConstraints lines 8-19  a warm start (below), then Jacobi iterations: lambda (eq. 11), delta p
-//                                       with s_corr (eq. 12-14), collision response, x* += delta p
+//                                       with s_corr (eq. 12-14), collision response, x* += delta p; the
+//                                       iterations are Chebyshev-accelerated (Wang 2015, see the .cpp)
 //   updateVelocities        line 21     v = (x* - x) / dt
 //   vorticity + XSPH        line 22     vorticity confinement (eq. 15-16), XSPH viscosity (eq. 17)
 //   commit                  line 23     x = x*
@@ -105,6 +106,7 @@ class PbfSolver final : public FluidSolver<Dim> {
   float coincidentLength_;
   float vorticityEpsilon_, xsphC_;
   float warmStart_;
+  float chebyshevRho_;  // 0: plain Jacobi
   int iterations_;
   double maxDensityError_;
   VecD gravity_;
@@ -117,6 +119,8 @@ class PbfSolver final : public FluidSolver<Dim> {
   std::vector<float> lambda_;
   std::vector<float> lambdaTotal_;  // the sums of each particle's lambdas this step; only with the warm start
   std::vector<float> scratchFloats_;
+  std::vector<float> appliedLambda_;  // the multiplier mu each particle's last iteration applied (Chebyshev)
+  float chebyshevOmega_ = 1;          // this iteration's weight
   std::vector<VecD> omega3_;    // vorticity (3D); allocated only when vorticity confinement is on
   std::vector<float> omega2_;   // vorticity (2D, a scalar)
   std::vector<VecD> scratch_;  // reordering, position corrections and XSPH velocities, in turn
