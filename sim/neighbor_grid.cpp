@@ -292,27 +292,35 @@ void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radi
           // The chunk's vector only grows (its size is its usable room); `used` counts what is filled.
           std::vector<uint32_t>& chunk = lists.chunks[c];
           size_t used = 0;
+          // The stencil's rows of candidates, kept while the particles (sorted by cell) stay in one cell.
+          constexpr int kRows = Dim == 3 ? 25 : 5;  // rows of a stencil of reach 2
+          uint32_t rowBegin[kRows], rowEnd[kRows];
+          int rows = 0;
+          size_t candidates = 0;
+          Cell rowsCell;
+          rowsCell.fill(-1);
           for (size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
             const Vec<Dim> xi = x[i];
             const Cell cell = cellCoordinates(xi);
-            Cell lo = cell, hi = cell;
-            for (int k = 0; k < Dim; ++k) {
-              lo[k] = std::max<int64_t>(cell[k] - reach, 0);
-              hi[k] = std::min<int64_t>(cell[k] + reach, resolution_[k] - 1);
-            }
-            constexpr int kRows = Dim == 3 ? 25 : 5;  // rows of a stencil of reach 2
-            uint32_t rowBegin[kRows], rowEnd[kRows];
-            int rows = 0;
-            size_t candidates = 0;
-            const int64_t z0 = Dim == 3 ? lo[Dim - 1] : 0, z1 = Dim == 3 ? hi[Dim - 1] : 0;
-            for (int64_t z = z0; z <= z1; ++z)
-              for (int64_t y = lo[1]; y <= hi[1]; ++y, ++rows) {
-                Cell first = lo, last = hi;
-                first[1] = last[1] = y;
-                if constexpr (Dim == 3) first[2] = last[2] = z;
-                slotsOfCells(linearIndex(first), linearIndex(last), rowBegin[rows], rowEnd[rows]);
-                candidates += rowEnd[rows] - rowBegin[rows];
+            if (cell != rowsCell) {
+              rowsCell = cell;
+              Cell lo = cell, hi = cell;
+              for (int k = 0; k < Dim; ++k) {
+                lo[k] = std::max<int64_t>(cell[k] - reach, 0);
+                hi[k] = std::min<int64_t>(cell[k] + reach, resolution_[k] - 1);
               }
+              rows = 0;
+              candidates = 0;
+              const int64_t z0 = Dim == 3 ? lo[Dim - 1] : 0, z1 = Dim == 3 ? hi[Dim - 1] : 0;
+              for (int64_t z = z0; z <= z1; ++z)
+                for (int64_t y = lo[1]; y <= hi[1]; ++y, ++rows) {
+                  Cell first = lo, last = hi;
+                  first[1] = last[1] = y;
+                  if constexpr (Dim == 3) first[2] = last[2] = z;
+                  slotsOfCells(linearIndex(first), linearIndex(last), rowBegin[rows], rowEnd[rows]);
+                  candidates += rowEnd[rows] - rowBegin[rows];
+                }
+            }
             // Room for every candidate, then keep those in range: no capacity check per neighbour.
             if (chunk.size() < used + candidates + kNeighborPadding) {
               // Grow to what the whole chunk will likely need (the mean so far times the chunk, plus a tenth),
