@@ -186,13 +186,11 @@ void PbfSolver<Dim>::solveDensityConstraints() {
   const auto start = PhaseClock::now();
   lastIterations_ = 0;
   if (warmStart_ > 0) applyWarmStart();
-  if (chebyshevRho_ > 0) appliedLambda_.assign(size(), 0.0f);
   const float rho2 = chebyshevRho_ * chebyshevRho_;
+  float omega = 1;  // 1 throughout with rho = 0: plain Jacobi
   for (int iteration = 0; iteration < iterations_; ++iteration) {
-    chebyshevOmega_ = iteration == 0 ? 1.0f
-                      : iteration == 1 ? 2.0f / (2.0f - rho2)
-                                       : 4.0f / (4.0f - rho2 * chebyshevOmega_);
-    const double averageError = computeLambdas();
+    omega = iteration == 0 ? 1.0f : iteration == 1 ? 2.0f / (2.0f - rho2) : 4.0f / (4.0f - rho2 * omega);
+    const double averageError = computeLambdas(omega);
     if (maxDensityError_ > 0 && averageError <= maxDensityError_) break;
     applyPositionCorrections<false>();
     ++lastIterations_;
@@ -221,7 +219,7 @@ void PbfSolver<Dim>::restoreCarriedState(const std::vector<float>& state) {
 // Eq. 8: grad_{p_k} C_i = (m / rho_0) sum_j grad W(p_i - p_j) for k = i, and -(m / rho_0) grad W(p_i - p_k)
 // for k = j. Eq. 11: lambda_i = -C_i / (sum_k |grad_{p_k} C_i|^2 + epsilon).
 template <int Dim>
-double PbfSolver<Dim>::computeLambdas() {
+double PbfSolver<Dim>::computeLambdas(float omega) {
   const float selfWeight = kernels_.poly6(0.0f);
   return parallelSum<double>(0, size(), [&](size_t b, size_t e) {
     double errorSum = 0;
@@ -282,13 +280,12 @@ double PbfSolver<Dim>::computeLambdas() {
         gradientI += massOverRho_ * colliderGradient;
       }
       const float constraint = std::max(mass_ * weight / restDensity_ - 1.0f, 0.0f);
-      lambda_[i] = -constraint / (gradientSquaredSum + gradientI.squaredNorm() + epsilon_);
-      if (!appliedLambda_.empty()) {  // the Chebyshev acceleration (see solveDensityConstraints)
-        // != 0 rather than > 0: a NaN constraint passes its NaN on, so that a blow-up still shows.
-        const float mu = constraint != 0.0f ? chebyshevOmega_ * lambda_[i] + (chebyshevOmega_ - 1.0f) * appliedLambda_[i]
-                                            : 0.0f;
-        lambda_[i] = appliedLambda_[i] = mu;
-      }
+      const float lambda = -constraint / (gradientSquaredSum + gradientI.squaredNorm() + epsilon_);
+      // The Chebyshev acceleration (see solveDensityConstraints): lambda_[i] still holds mu_k-1, the multiplier
+      // the last iteration applied. != 0 rather than > 0: a NaN constraint passes its NaN on, so that a blow-up
+      // still shows.
+      if (omega != 1.0f) lambda_[i] = constraint != 0.0f ? omega * lambda + (omega - 1.0f) * lambda_[i] : 0.0f;
+      else lambda_[i] = lambda;
       // The warm start's sums forget a particle that is not compressed (see the header).
       if (constraint == 0.0f && !lambdaTotal_.empty()) lambdaTotal_[i] = 0.0f;
       errorSum += constraint;
@@ -521,8 +518,7 @@ template <int Dim>
 size_t PbfSolver<Dim>::memoryBytes() const {
   size_t bytes = (x_.capacity() + v_.capacity() + p_.capacity() + scratch_.capacity() + omega3_.capacity()) * sizeof(VecD);
   bytes += (id_.capacity() + scratchIds_.capacity()) * sizeof(uint32_t);
-  bytes += (lambda_.capacity() + lambdaTotal_.capacity() + appliedLambda_.capacity() + scratchFloats_.capacity() +
-            omega2_.capacity()) *
+  bytes += (lambda_.capacity() + lambdaTotal_.capacity() + scratchFloats_.capacity() + omega2_.capacity()) *
            sizeof(float);
   for (const auto& factors : pairGradientFactors_) bytes += factors.capacity() * sizeof(float);
   return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes();

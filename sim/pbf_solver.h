@@ -79,7 +79,9 @@ class PbfSolver final : public FluidSolver<Dim> {
   void predictPositions(float dt, double time);
   void findNeighbors();
   void solveDensityConstraints();
-  double computeLambdas();  // returns the average density error before this iteration's correction
+  // Eq. 11 (with the Chebyshev weight omega of this iteration, 1 for plain Jacobi); returns the average density
+  // error before this iteration's correction.
+  double computeLambdas(float omega);
   void applyWarmStart();
   // Eq. 12 from lambda_: an iteration's correction, or with kWarmStart the warm start's (kernel gradients
   // evaluated here rather than read from the lambda pass, no s_corr, nothing added to the lambda totals).
@@ -119,8 +121,6 @@ class PbfSolver final : public FluidSolver<Dim> {
   std::vector<float> lambda_;
   std::vector<float> lambdaTotal_;  // the sums of each particle's lambdas this step; only with the warm start
   std::vector<float> scratchFloats_;
-  std::vector<float> appliedLambda_;  // the multiplier mu each particle's last iteration applied (Chebyshev)
-  float chebyshevOmega_ = 1;          // this iteration's weight
   std::vector<VecD> omega3_;    // vorticity (3D); allocated only when vorticity confinement is on
   std::vector<float> omega2_;   // vorticity (2D, a scalar)
   std::vector<VecD> scratch_;  // reordering, position corrections and XSPH velocities, in turn
