@@ -109,8 +109,155 @@ void Colliders<Dim>::beginStep(double time, float dt) {
     const float grow = support_ + radius_;
     k.near = Eigen::AlignedBox<float, Dim>(world.min().template head<Dim>() - Vec<Dim>::Constant(grow),
                                            world.max().template head<Dim>() + Vec<Dim>::Constant(grow));
+    // Bodies keep the flat wall: with a box's exact edges, a heavy box resting on a trapped layer of water
+    // rocked at the default 4 x 4 (docs/bodies.md).
+    if (shape.kind == ShapeKind::Box && !shape.container && !body) placeBox(k);
   }
   buildGrid();
+}
+
+template <int Dim>
+void Colliders<Dim>::placeBox(Placed& k) const {
+  k.boxMax = k.shape->halfExtents * k.scale;
+  k.boxMin = -k.boxMax;
+  k.exactBox = false;
+  // In 2D the box is cut by the plane z = 0: its own z axis must be the world's.
+  if (Dim == 2 && std::abs(k.rotation(2, 2)) < 1 - 1e-6f) return;
+  // A box inside the tank (within a quarter spacing, as a body resting on the floor may sink) shares no
+  // lattice with the tank's walls.
+  const float tolerance = 0.5f * radius_;
+  bool inside = true;
+  for (int corner = 0; corner < (1 << Dim); ++corner) {
+    Eigen::Vector3f local;
+    for (int a = 0; a < 3; ++a) local[a] = (corner >> a & 1) ? k.boxMax[a] : k.boxMin[a];
+    const VecD at = (k.rotation * local + k.translation).template head<Dim>();
+    inside = inside && (at.array() >= tank_->domainMin().array() - tolerance).all() &&
+             (at.array() <= tank_->domainMax().array() + tolerance).all();
+  }
+  if (inside) {
+    k.exactBox = true;
+    return;
+  }
+  // A box square to the tank that reaches through its walls (a plate across the tank) is cut back to them.
+  for (int a = 0; a < Dim; ++a) {
+    int axis = 0;
+    for (int w = 1; w < 3; ++w)
+      if (std::abs(k.rotation(w, a)) > std::abs(k.rotation(axis, a))) axis = w;
+    if (axis >= Dim || std::abs(k.rotation(axis, a)) < 1 - 1e-6f) return;
+    const float sign = k.rotation(axis, a) > 0 ? 1.0f : -1.0f;
+    // The tank along `axis`, in the box's frame along a.
+    float lo = (tank_->domainMin()[axis] - k.translation[axis]) * sign;
+    float hi = (tank_->domainMax()[axis] - k.translation[axis]) * sign;
+    if (lo > hi) std::swap(lo, hi);
+    k.boxMin[a] = std::max(k.boxMin[a], lo);
+    k.boxMax[a] = std::min(k.boxMax[a], hi);
+  }
+  k.exactBox = true;
+}
+
+// Calls visit(sign, walls, axes, distances, towards) for every term of a box's lattice at q (in its frame):
+// the intersection of the half-spaces beyond `walls` faces on the distinct axes axes[0..walls-1], at distances
+// distances[m] from q, lying towards towards[m] (+1 or -1 along the axis), counted with `sign`. Along each axis
+// the fluid's side is one or two half-spaces beyond faces, or everything between them less the two beyond; the
+// solid is the product over the axes, expanded.
+template <int Dim, typename Visit>
+void forEachBoxTerm(const Eigen::Vector3f& q, const Eigen::Vector3f& boxMin, const Eigen::Vector3f& boxMax,
+                    float support, Visit&& visit) {
+  struct Factor {
+    float distance;  // < 0: everything along this axis
+    float towards, sign;
+  };
+  Factor factors[Dim][3];
+  int count[Dim];
+  for (int a = 0; a < Dim; ++a) {
+    const float x = q[a], lo = boxMin[a], hi = boxMax[a];
+    int n = 0;
+    if (x > hi) {
+      factors[a][n++] = {x - hi, -1, 1};
+      if (x - lo < support) factors[a][n++] = {x - lo, -1, -1};
+    } else if (x < lo) {
+      factors[a][n++] = {lo - x, 1, 1};
+      if (hi - x < support) factors[a][n++] = {hi - x, 1, -1};
+    } else {
+      factors[a][n++] = {-1, 0, 1};
+      if (hi - x < support) factors[a][n++] = {hi - x, 1, -1};
+      if (x - lo < support) factors[a][n++] = {x - lo, -1, -1};
+    }
+    count[a] = n;
+  }
+  const int combinations = Dim == 3 ? count[0] * count[1] * count[Dim - 1] : count[0] * count[1];
+  for (int combination = 0; combination < combinations; ++combination) {
+    int rest = combination, axes[3], walls = 0;
+    float distances[3], towards[3], sign = 1;
+    for (int a = Dim - 1; a >= 0; --a) {
+      const Factor& f = factors[a][rest % count[a]];
+      rest /= count[a];
+      sign *= f.sign;
+      if (f.distance < 0) continue;
+      axes[walls] = a;
+      distances[walls] = f.distance;
+      towards[walls++] = f.towards;
+    }
+    if (walls > 0) visit(sign, walls, axes, distances, towards);
+  }
+}
+
+template <int Dim>
+void Colliders<Dim>::boxTerms(const Placed& k, const VecD& p, float& weight, VecD& gradient) const {
+  Eigen::Vector3f world = Eigen::Vector3f::Zero();
+  world.template head<Dim>() = p;
+  const Eigen::Vector3f q = k.rotation.transpose() * (world - k.translation);
+  float w = 0;
+  Eigen::Vector3f g = Eigen::Vector3f::Zero();
+  forEachBoxTerm<Dim>(q, k.boxMin, k.boxMax, support_,
+                      [&](float sign, int walls, const int* axes, const float* distances, const float* towards) {
+                        float termWeight = 0, magnitudes[3] = {0, 0, 0};
+                        if (walls == 1) {
+                          tank_->flatWall().lookup(distances[0], termWeight, magnitudes[0]);
+                        } else if (walls == 2) {
+                          if (!tank_->edgeTerms(distances[0], distances[1], termWeight, magnitudes[0], magnitudes[1]))
+                            return;
+                        } else if constexpr (Dim == 3) {
+                          if (!tank_->cornerTerms(distances, termWeight, magnitudes)) return;
+                        }
+                        w += sign * termWeight;
+                        for (int m = 0; m < walls; ++m) g[axes[m]] += sign * magnitudes[m] * towards[m];
+                      });
+  weight = w;
+  gradient = (k.rotation * g).template head<Dim>();
+}
+
+template <int Dim>
+typename Colliders<Dim>::VecD Colliders<Dim>::boxHydrostaticSum(const Placed& k, const VecD& p,
+                                                                const VecD& gravity) const {
+  Eigen::Vector3f world = Eigen::Vector3f::Zero(), g = Eigen::Vector3f::Zero();
+  world.template head<Dim>() = p;
+  g.template head<Dim>() = gravity;
+  const Eigen::Vector3f q = k.rotation.transpose() * (world - k.translation), gl = k.rotation.transpose() * g;
+  // sum_b (g . (x_b - x_i)) grad W = -M g, M = sum_b (W'(r) / r) r r^T over the term's lattice (r = x_i - x_b).
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  forEachBoxTerm<Dim>(q, k.boxMin, k.boxMax, support_,
+                      [&](float sign, int walls, const int* axes, const float* distances, const float* towards) {
+                        Eigen::Matrix3f m = Eigen::Matrix3f::Zero();
+                        if (walls == 1) {
+                          float normal, tangent;
+                          tank_->flatWall().moments(distances[0], normal, tangent);
+                          for (int a = 0; a < Dim; ++a) m(a, a) = a == axes[0] ? normal : tangent;
+                        } else if (walls == 2) {
+                          float e[4];
+                          if (!tank_->edgeMoments(distances[0], distances[1], e)) return;
+                          for (int a = 0; a < Dim; ++a) m(a, a) = e[2];  // along the edge
+                          m(axes[0], axes[0]) = e[0];
+                          m(axes[1], axes[1]) = e[1];
+                          // The table's r points away from the quarter on both axes; here r_a has the sign
+                          // -towards[a].
+                          m(axes[0], axes[1]) = m(axes[1], axes[0]) = towards[0] * towards[1] * e[3];
+                        } else {
+                          return;  // a corner's eighth: its moments are not tabulated (docs/colliders.md)
+                        }
+                        sum -= sign * (m * gl);
+                      });
+  return (k.rotation * sum).template head<Dim>();
 }
 
 template <int Dim>

@@ -85,9 +85,15 @@ class Colliders {
     }
   }
 
-  // A collider's share of sum_b W(p - p_b) (weight) and sum_b grad_p W(p - p_b) (gradient) at p, at distance d
-  // along the normal n: the flat wall's, less what it shares with a tank wall it stands square on.
-  void wallTerms(const VecD& p, float d, const VecD& n, float& weight, VecD& gradient) const {
+  // Collider c's share of sum_b W(p - p_b) (weight) and sum_b grad_p W(p - p_b) (gradient) at p, at distance d
+  // along the normal n. A box (boxTerms) counts the lattice beyond its faces, edges and corners exactly, by
+  // the tank's tables; every other shape counts the flat wall's, less what it shares with a tank wall it stands
+  // square on.
+  void wallTerms(size_t c, const VecD& p, float d, const VecD& n, float& weight, VecD& gradient) const {
+    if (placed_[c].exactBox && d > 0) {
+      boxTerms(placed_[c], p, weight, gradient);
+      return;
+    }
     float w, g;
     tank_->flatWall().lookup(d, w, g);
     weight = w;
@@ -100,14 +106,18 @@ class Colliders {
   // sum_b (g . (x_b - x_i)) grad W(x_i - x_b) over the flat wall at d along n; the wall's push on the particle
   // gains -m / rho_i times it. Mirroring p_i alone (p_b = p_i) pushes too hard on a particle below a wall and
   // too softly above one: a ball under water read 27% over Archimedes in 3D (docs/colliders.md).
-  VecD hydrostaticSum(float d, const VecD& n, const VecD& g) const { return tank_->flatWall().hydrostaticSum(d, n, g); }
+  // A box sums it over its exact lattice (boxTerms; a corner's eighth left out).
+  VecD hydrostaticSum(size_t c, const VecD& p, float d, const VecD& n, const VecD& g) const {
+    if (placed_[c].exactBox && d > 0) return boxHydrostaticSum(placed_[c], p, g);
+    return tank_->flatWall().hydrostaticSum(d, n, g);
+  }
 
   // Adds every collider's share of the density sums at p (as TankWalls::add does for the tank).
   void add(const VecD& p, float& weight, VecD& gradient) const {
-    forEachNear(p, [&](size_t, float d, const VecD& n) {
+    forEachNear(p, [&](size_t c, float d, const VecD& n) {
       float w;
       VecD g;
-      wallTerms(p, d, n, w, g);
+      wallTerms(c, p, d, n, w, g);
       weight += w;
       gradient += g;
     });
@@ -183,7 +193,20 @@ class Colliders {
     Eigen::AlignedBox<float, Dim> near;  // particles outside it are beyond the support
     float friction = 0, frictionThisStep = 0;
     bool moving = false;
+    // A box counted exactly (boxTerms): its faces in its frame at boxMin and boxMax (metres), cut back to the
+    // tank where it reaches through a wall it is square to.
+    bool exactBox = false;
+    Eigen::Vector3f boxMin = Eigen::Vector3f::Zero(), boxMax = Eigen::Vector3f::Zero();
   };
+
+  // The lattice beyond a box (Placed::exactBox) from p outside it: along each of its axes the fluid's side of
+  // the box is one or two half-spaces beyond its faces (or everything, between them); the solid is their
+  // product over the axes, expanded into intersections of half-spaces on distinct axes, each one of the tank's
+  // tables (a face, an edge's quarter, a corner's eighth), with signs (inclusion-exclusion).
+  void boxTerms(const Placed& k, const VecD& p, float& weight, VecD& gradient) const;
+  VecD boxHydrostaticSum(const Placed& k, const VecD& p, const VecD& gravity) const;
+  // Decides Placed::exactBox for a box placed by beginStep.
+  void placeBox(Placed& k) const;
 
   bool sweep(size_t c, const VecD& from, const VecD& p, bool fromStepStart, VecD& delta) const;
 

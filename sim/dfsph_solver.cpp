@@ -185,7 +185,7 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
         colliders_.forEachNear(xi, [&](size_t c, float d, const VecD& normal) {
           float w;
           VecD gradient;
-          colliders_.wallTerms(xi, d, normal, w, gradient);
+          colliders_.wallTerms(c, xi, d, normal, w, gradient);
           wallWeight += w;
           wall += gradient;
           flux += colliders_.wallVelocity(c, xi).dot(gradient);
@@ -305,7 +305,7 @@ void DfsphSolver<Dim>::recordColliderImpulses(const std::vector<float>& lambda, 
       colliders_.forEachNear(x_[i], [&](size_t c, float d, const VecD& normal) {
         float unused;
         VecD gradient;
-        colliders_.wallTerms(x_[i], d, normal, unused, gradient);
+        colliders_.wallTerms(c, x_[i], d, normal, unused, gradient);
         colliders_.addImpulse(i, c, (scale * lambda[i]) * gradient, x_[i]);
       });
     }

@@ -396,7 +396,7 @@ typename PbfSolver<Dim>::VecD PbfSolver<Dim>::colliderCorrection(size_t i, const
   colliders_.forEachNear(p, [&](size_t c, float d, const VecD& n) {
     float unused;
     VecD gradient;
-    colliders_.wallTerms(p, d, n, unused, gradient);
+    colliders_.wallTerms(c, p, d, n, unused, gradient);
     const VecD move = (massOverRho_ * lambda) * gradient;
     delta += move;
     colliders_.addImpulse(i, c, (mass_ / stepDt_) * move, p);

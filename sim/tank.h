@@ -105,7 +105,7 @@ class TankWalls {
     flat_.scale = kTableSize / support;
     for (int t = 0; t <= kTableSize; ++t) {
       const float d[1] = {support * t / kTableSize};
-      double g[3], moments[2];
+      double g[3], moments[4];
       flat_.weight[t] = static_cast<float>(beyond(1, d, g, moments));
       flat_.gradient[t] = static_cast<float>(-g[0]);  // g[0] <= 0: towards the wall
       flat_.normalMoment[t] = static_cast<float>(moments[0]);
@@ -118,9 +118,10 @@ class TankWalls {
     for (int ta = 0; ta <= kEdgeTableSize; ++ta)
       for (int tb = 0; tb <= kEdgeTableSize; ++tb) {
         const float d[2] = {support * ta / kEdgeTableSize, support * tb / kEdgeTableSize};
-        double g[3];
-        const double w = beyond(2, d, g);
-        edge_[ta * (kEdgeTableSize + 1) + tb] = {float(w), float(-g[0]), float(-g[1])};
+        double g[3], m[4];
+        const double w = beyond(2, d, g, m);
+        edge_[ta * (kEdgeTableSize + 1) + tb] = {float(w), float(-g[0]), float(-g[1]),
+                                                 {float(m[0]), float(m[1]), float(m[2]), float(m[3])}};
       }
     // Where three walls meet (3D): each wall added the eighth beyond all three, each of the three edges took
     // it away; tabulate it (distances to the three walls) so add() counts it once again.
@@ -161,18 +162,9 @@ class TankWalls {
           const int side = sides & 1, side2 = sides >> 1;
           const float d = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
           const float d2 = side2 == 0 ? p[k2] - domainMin_[k2] : domainMax_[k2] - p[k2];
-          const float u = std::max(d, 0.0f) * edgeScale_, u2 = std::max(d2, 0.0f) * edgeScale_;
-          if (!(u < kEdgeTableSize) || !(u2 < kEdgeTableSize)) continue;
-          const int t = static_cast<int>(u), t2 = static_cast<int>(u2);
-          const float f = u - t, f2 = u2 - t2;
-          auto at = [&](int a, int b) { return edge_[a * (kEdgeTableSize + 1) + b]; };
-          const EdgeEntry e00 = at(t, t2), e01 = at(t, t2 + 1), e10 = at(t + 1, t2), e11 = at(t + 1, t2 + 1);
-          auto blend = [&](float EdgeEntry::*field) {
-            return (1 - f) * ((1 - f2) * e00.*field + f2 * e01.*field) +
-                   f * ((1 - f2) * e10.*field + f2 * e11.*field);
-          };
-          weight -= blend(&EdgeEntry::weight);
-          const float ga = blend(&EdgeEntry::gradientA), gb = blend(&EdgeEntry::gradientB);
+          float w, ga, gb;
+          if (!edgeTerms(d, d2, w, ga, gb)) continue;
+          weight -= w;
           gradient[k] -= side == 0 ? -ga : ga;
           gradient[k2] -= side2 == 0 ? -gb : gb;
         }
@@ -187,28 +179,81 @@ class TankWalls {
   // counted by each; subtracts it once (the edge table above, as add() does where two walls meet), from weight
   // and from gradient. Other angles are left as they are (docs/colliders.md).
   void subtractOverlap(const VecD& p, float d, const VecD& n, float& weight, VecD& gradient) const {
-    const float u2 = std::max(d, 0.0f) * edgeScale_;
-    if (!(u2 < kEdgeTableSize)) return;
+    if (!(std::max(d, 0.0f) * edgeScale_ < kEdgeTableSize)) return;
     for (int k = 0; k < Dim; ++k) {
       if (std::abs(n[k]) >= 0.2f) continue;
       for (int side = 0; side < 2; ++side) {
         const float dw = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
-        const float u = std::max(dw, 0.0f) * edgeScale_;
-        if (!(u < kEdgeTableSize)) continue;
-        const int t = static_cast<int>(u), t2 = static_cast<int>(u2);
-        const float f = u - t, f2 = u2 - t2;
-        auto at = [&](int a, int b) { return edge_[a * (kEdgeTableSize + 1) + b]; };
-        const EdgeEntry e00 = at(t, t2), e01 = at(t, t2 + 1), e10 = at(t + 1, t2), e11 = at(t + 1, t2 + 1);
-        auto blend = [&](float EdgeEntry::*field) {
-          return (1 - f) * ((1 - f2) * e00.*field + f2 * e01.*field) + f * ((1 - f2) * e10.*field + f2 * e11.*field);
-        };
-        weight -= blend(&EdgeEntry::weight);
+        float w, ga, gb;
+        if (!edgeTerms(dw, d, w, ga, gb)) continue;
+        weight -= w;
         VecD wallNormal = VecD::Zero();
         wallNormal[k] = side == 0 ? 1.0f : -1.0f;
         // The quarter's gradient points towards both boundaries: -ga along the wall's normal, -gb along n.
-        gradient += blend(&EdgeEntry::gradientA) * wallNormal + blend(&EdgeEntry::gradientB) * n;
+        gradient += ga * wallNormal + gb * n;
       }
     }
+  }
+
+  // The lattice beyond two perpendicular walls at distances da and db (the quarter beyond both; the tables
+  // above): its weight sum w and its gradient's magnitudes towards each wall, ga and gb. False (and nothing
+  // written) when either wall is beyond the support.
+  bool edgeTerms(float da, float db, float& w, float& ga, float& gb) const {
+    const float u = std::max(da, 0.0f) * edgeScale_, u2 = std::max(db, 0.0f) * edgeScale_;
+    if (!(u < kEdgeTableSize) || !(u2 < kEdgeTableSize)) return false;  // also NaN
+    const int t = static_cast<int>(u), t2 = static_cast<int>(u2);
+    const float f = u - t, f2 = u2 - t2;
+    auto at = [&](int a, int b) { return edge_[a * (kEdgeTableSize + 1) + b]; };
+    const EdgeEntry e00 = at(t, t2), e01 = at(t, t2 + 1), e10 = at(t + 1, t2), e11 = at(t + 1, t2 + 1);
+    auto blend = [&](float EdgeEntry::*field) {
+      return (1 - f) * ((1 - f2) * e00.*field + f2 * e01.*field) + f * ((1 - f2) * e10.*field + f2 * e11.*field);
+    };
+    w = blend(&EdgeEntry::weight);
+    ga = blend(&EdgeEntry::gradientA);
+    gb = blend(&EdgeEntry::gradientB);
+    return true;
+  }
+
+  // The same quarter's moments (EdgeEntry::moments), bilinear in the table; false beyond the support.
+  bool edgeMoments(float da, float db, float m[4]) const {
+    const float u = std::max(da, 0.0f) * edgeScale_, u2 = std::max(db, 0.0f) * edgeScale_;
+    if (!(u < kEdgeTableSize) || !(u2 < kEdgeTableSize)) return false;
+    const int t = static_cast<int>(u), t2 = static_cast<int>(u2);
+    const float f = u - t, f2 = u2 - t2;
+    auto at = [&](int a, int b) -> const EdgeEntry& { return edge_[a * (kEdgeTableSize + 1) + b]; };
+    for (int k = 0; k < 4; ++k)
+      m[k] = (1 - f) * ((1 - f2) * at(t, t2).moments[k] + f2 * at(t, t2 + 1).moments[k]) +
+             f * ((1 - f2) * at(t + 1, t2).moments[k] + f2 * at(t + 1, t2 + 1).moments[k]);
+    return true;
+  }
+
+  // The lattice beyond three perpendicular walls at distances d[0..2] (3D; the eighth beyond all three): its
+  // weight sum w and its gradient's magnitudes towards each wall. False when any wall is beyond the support.
+  bool cornerTerms(const float d[3], float& w, float g[3]) const {
+    constexpr int n = kEdgeTableSize + 1;
+    int t[3];
+    float f[3];
+    for (int k = 0; k < 3; ++k) {
+      const float u = std::max(d[k], 0.0f) * edgeScale_;
+      if (!(u < kEdgeTableSize)) return false;  // also NaN
+      t[k] = static_cast<int>(u);
+      f[k] = u - t[k];
+    }
+    w = 0;
+    g[0] = g[1] = g[2] = 0;
+    for (int c = 0; c < 8; ++c) {
+      float s = 1;
+      int index[3];
+      for (int k = 0; k < 3; ++k) {
+        const int up = (c >> k) & 1;
+        s *= up ? f[k] : 1 - f[k];
+        index[k] = t[k] + up;
+      }
+      const CornerEntry& entry = corner_[(size_t(index[0]) * n + index[1]) * n + index[2]];
+      w += s * entry.weight;
+      for (int k = 0; k < 3; ++k) g[k] += s * entry.gradient[k];
+    }
+    return true;
   }
 
   // The clamp below as a bound on a velocity: over a move of dt from p, v may take the particle no further than
@@ -238,6 +283,9 @@ class TankWalls {
     return moved;
   }
 
+  const VecD& domainMin() const { return domainMin_; }
+  const VecD& domainMax() const { return domainMax_; }
+
   bool contains(const VecD& p) const {
     return (p.array() >= domainMin_.array()).all() && (p.array() <= domainMax_.array()).all();
   }
@@ -246,7 +294,8 @@ class TankWalls {
   // Over the lattice beyond `walls` walls whose normals are axes 0 .. walls-1, at distances d[a] from the
   // particle (layers d[a] + spacing / 2 + i spacing, i >= 0, on those axes; every tangential offset within
   // `reach` on the others): returns the sum of weight(r) and writes the sum of gradient(r) to g, and, if asked,
-  // sum r_0 gradient_0(r) and sum r_1 gradient_1(r) to moments.
+  // the moments sum r_0 gradient_0(r), sum r_1 gradient_1(r), sum r_2 gradient_2(r) (3D) and
+  // sum r_0 gradient_1(r) (= sum r_1 gradient_0(r): the gradient is along r).
   template <typename Weight, typename Gradient>
   static double sumBeyond(int walls, const float* d, float spacing, int reach, const Weight& weight,
                           const Gradient& gradient, double* g, double* moments = nullptr) {
@@ -256,7 +305,7 @@ class TankWalls {
       lo[a] = a < walls ? 0 : -reach;
       hi[a] = reach;
     }
-    double w = 0, normalMoment = 0, tangentMoment = 0;
+    double w = 0, normalMoment = 0, tangentMoment = 0, thirdMoment = 0, crossMoment = 0;
     g[0] = g[1] = g[2] = 0;
     for (int i = lo[0]; i <= hi[0]; ++i)
       for (int j = lo[1]; j <= hi[1]; ++j)
@@ -270,61 +319,45 @@ class TankWalls {
           for (int a = 0; a < Dim; ++a) g[a] += gr[a];
           normalMoment += r[0] * gr[0];
           tangentMoment += r[1] * gr[1];
+          if constexpr (Dim == 3) thirdMoment += r[2] * gr[2];
+          crossMoment += r[0] * gr[1];
         }
     if (moments) {
       moments[0] = normalMoment;
       moments[1] = tangentMoment;
+      moments[2] = thirdMoment;
+      moments[3] = crossMoment;
     }
     return w;
   }
 
-  // The corners' share of add(): trilinear in the table of the eighth beyond three walls, for every corner
-  // whose three walls are all within the support (none, for all but the particles in a corner).
+  // The corners' share of add(): the eighth beyond three walls, for every corner whose three walls are all
+  // within the support (none, for all but the particles in a corner).
   void addCorners(const VecD& p, float& weight, VecD& gradient) const {
-    constexpr int n = kEdgeTableSize + 1;
-    int t[3][2], sides[3][2], count[3];
-    float f[3][2];
+    float d[3][2];
     for (int k = 0; k < 3; ++k) {
-      count[k] = 0;
-      for (int side = 0; side < 2; ++side) {
-        const float d = side ? domainMax_[k] - p[k] : p[k] - domainMin_[k];
-        const float u = std::max(d, 0.0f) * edgeScale_;
-        if (!(u < kEdgeTableSize)) continue;  // also skips NaN
-        const int c = count[k]++;
-        sides[k][c] = side;
-        t[k][c] = static_cast<int>(u);
-        f[k][c] = u - t[k][c];
-      }
-      if (count[k] == 0) return;
+      d[k][0] = p[k] - domainMin_[k];
+      d[k][1] = domainMax_[k] - p[k];
+      const float reach = 1.001f * kEdgeTableSize / edgeScale_;  // a margin over the rounding; cornerTerms decides
+      if (!(d[k][0] < reach) && !(d[k][1] < reach)) return;  // no wall of this axis within the support
     }
-    for (int i = 0; i < count[0]; ++i)
-      for (int j = 0; j < count[1]; ++j)
-        for (int l = 0; l < count[2]; ++l) {
-          const int at[3] = {t[0][i], t[1][j], t[2][l]};
-          const float fr[3] = {f[0][i], f[1][j], f[2][l]};
-          float w = 0, g[3] = {0, 0, 0};
-          for (int c = 0; c < 8; ++c) {
-            float s = 1;
-            int index[3];
-            for (int k = 0; k < 3; ++k) {
-              const int up = (c >> k) & 1;
-              s *= up ? fr[k] : 1 - fr[k];
-              index[k] = at[k] + up;
-            }
-            const CornerEntry& entry = corner_[(size_t(index[0]) * n + index[1]) * n + index[2]];
-            w += s * entry.weight;
-            for (int k = 0; k < 3; ++k) g[k] += s * entry.gradient[k];
-          }
-          weight += w;
-          const int side[3] = {sides[0][i], sides[1][j], sides[2][l]};
-          for (int k = 0; k < 3; ++k) gradient[k] += side[k] ? g[k] : -g[k];
-        }
+    for (int corner = 0; corner < 8; ++corner) {
+      const int side[3] = {corner >> 2 & 1, corner >> 1 & 1, corner & 1};  // axis 0 slowest, as summed before
+      const float at[3] = {d[0][side[0]], d[1][side[1]], d[2][side[2]]};
+      float w, g[3];
+      if (!cornerTerms(at, w, g)) continue;
+      weight += w;
+      for (int k = 0; k < 3; ++k) gradient[k] += side[k] ? g[k] : -g[k];
+    }
   }
 
   static constexpr int kTableSize = 64;
   static constexpr int kEdgeTableSize = 32;
   struct EdgeEntry {
     float weight = 0, gradientA = 0, gradientB = 0;  // gradients: magnitudes towards each wall
+    // sum r_a grad_a, sum r_b grad_b, sum r_t grad_t (t along the edge, 3D), sum r_a grad_b; the table's r
+    // points from the quarter to the particle on both axes (WCSPH's hydrostatic wall pressure at a box's edge)
+    float moments[4] = {0, 0, 0, 0};
   };
   VecD domainMin_, domainMax_, clampMin_, clampMax_, interiorMin_, interiorMax_;
   FlatWallTable flat_;

@@ -216,9 +216,9 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
         colliders_.forEachNear(x_[i], [&](size_t c, float d, const VecD& n) {
           float unused;
           VecD gradient;
-          colliders_.wallTerms(x_[i], d, n, unused, gradient);
+          colliders_.wallTerms(c, x_[i], d, n, unused, gradient);
           const VecD force = -2.0f * pressureTermI * gradient -
-                             (1.0f / density_[i]) * colliders_.hydrostaticSum(d, n, gravity_);
+                             (1.0f / density_[i]) * colliders_.hydrostaticSum(c, x_[i], d, n, gravity_);
           pressureForce += force;
           colliders_.addImpulse(i, c, (mass_ * mass_) * force, x_[i]);
         });
