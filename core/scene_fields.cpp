@@ -185,8 +185,9 @@ void visitScene(Scene& s, SceneVisitor& v) {
                       "before the Jacobi iterations (a warm start, as DFSPH's); fewer iterations, but it adds "
                       "kinetic energy to a deep 2D dam break (docs/speed-accuracy.md); 0 turns it off", "", 0.9));
     v.real("chebyshev_rho", s.solver.chebyshev_rho,
-           atLeast(0, "PBF, when iterating to max_density_error: the Jacobi iterations' spectral radius that their "
-                      "Chebyshev acceleration assumes (Wang 2015); the larger, the fewer iterations for the same "
+           atLeast(0, "PBF, when iterating to max_density_error with iterations >= 8: the Jacobi iterations' "
+                      "spectral radius that their Chebyshev acceleration assumes (Wang 2015); the larger, the "
+                      "fewer iterations for the same "
                       "density error, up to where it overshoots (0.95 blows a dam break up; "
                       "docs/speed-accuracy.md); 0 turns it off", "", 0.95));
     v.real("max_density_error", s.solver.max_density_error,

@@ -109,6 +109,7 @@ class PbfSolver final : public FluidSolver<Dim> {
   float vorticityEpsilon_, xsphC_;
   float warmStart_;
   float chebyshevRho_;  // 0: plain Jacobi
+  static constexpr int kChebyshevLeastIterations = 8;  // the accelerated loop's smallest cap (solver.iterations)
   int iterations_;
   double maxDensityError_;
   VecD gravity_;
