@@ -31,6 +31,8 @@ struct SolverSettings {
   double relaxation_epsilon = 0.01;
   double warm_start = 0;  // PBF: share of last step's lambda sums applied before the iterations (experimental)
   double chebyshev_rho = 0.85;  // PBF to max_density_error: the spectral radius its Chebyshev acceleration assumes
+  // The smallest `iterations` cap the acceleration runs under: cut shorter, it stirs the fluid (sim/pbf_solver.cpp).
+  static constexpr int kChebyshevLeastIterations = 8;
   double max_density_error = 0;  // > 0: iterate until the average density error is under it (DFSPH: 0 means 0.0005)
   double max_divergence_error = 0.001;  // DFSPH's divergence solver: average density change a step would cause
   int max_iterations = 100;             // DFSPH: the most iterations of each of its solvers a step

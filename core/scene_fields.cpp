@@ -184,12 +184,12 @@ void visitScene(Scene& s, SceneVisitor& v) {
            atLeast(0, "PBF, experimental: the share of the last step's lambda sums applied as one correction "
                       "before the Jacobi iterations (a warm start, as DFSPH's); fewer iterations, but it adds "
                       "kinetic energy to a deep 2D dam break (docs/speed-accuracy.md); 0 turns it off", "", 0.9));
+    static_assert(SolverSettings::kChebyshevLeastIterations == 8, "chebyshev_rho's description names the cap");
     v.real("chebyshev_rho", s.solver.chebyshev_rho,
            atLeast(0, "PBF, when iterating to max_density_error with iterations >= 8: the Jacobi iterations' "
                       "spectral radius that their Chebyshev acceleration assumes (Wang 2015); the larger, the "
-                      "fewer iterations for the same "
-                      "density error, up to where it overshoots (0.95 blows a dam break up; "
-                      "docs/speed-accuracy.md); 0 turns it off", "", 0.95));
+                      "fewer iterations for the same density error, up to where it overshoots (0.95 blows a dam "
+                      "break up; docs/speed-accuracy.md); 0 turns it off", "", 0.95));
     v.real("max_density_error", s.solver.max_density_error,
            atLeast(0, "PBF: when > 0, iterate until the average density error (a fraction) is under it, at most "
                       "`iterations` times; 0 runs exactly `iterations`. DFSPH: its density solver's limit on the "

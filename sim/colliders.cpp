@@ -238,23 +238,20 @@ typename Colliders<Dim>::VecD Colliders<Dim>::boxHydrostaticSum(const Placed& k,
   Eigen::Vector3f sum = Eigen::Vector3f::Zero();
   forEachBoxTerm<Dim>(q, k.boxMin, k.boxMax, support_,
                       [&](float sign, int walls, const int* axes, const float* distances, const float* towards) {
-                        Eigen::Matrix3f m = Eigen::Matrix3f::Zero();
-                        if (walls == 1) {
-                          float normal, tangent;
-                          tank_->flatWall().moments(distances[0], normal, tangent);
-                          for (int a = 0; a < Dim; ++a) m(a, a) = a == axes[0] ? normal : tangent;
-                        } else if (walls == 2) {
-                          float e[4];
-                          if (!tank_->edgeMoments(distances[0], distances[1], e)) return;
-                          for (int a = 0; a < Dim; ++a) m(a, a) = e[2];  // along the edge
-                          m(axes[0], axes[0]) = e[0];
-                          m(axes[1], axes[1]) = e[1];
-                          // The table's r points away from the quarter on both axes; here r_a has the sign
-                          // -towards[a].
-                          m(axes[0], axes[1]) = m(axes[1], axes[0]) = towards[0] * towards[1] * e[3];
-                        } else {
-                          return;  // a corner's eighth: its moments are not tabulated (docs/colliders.md)
+                        if (walls == 1) {  // a face: the flat wall's own sum, along its axis
+                          const Eigen::Vector3f axis = Eigen::Vector3f::Unit(axes[0]);
+                          sum += sign * tank_->flatWall().hydrostaticSum(distances[0], axis, gl);
+                          return;
                         }
+                        // An edge's quarter; a corner's eighth has no tabulated moments (docs/colliders.md).
+                        float e[4];
+                        if (walls != 2 || !tank_->edgeMoments(distances[0], distances[1], e)) return;
+                        Eigen::Matrix3f m = Eigen::Matrix3f::Zero();
+                        for (int a = 0; a < Dim; ++a) m(a, a) = e[2];  // along the edge
+                        m(axes[0], axes[0]) = e[0];
+                        m(axes[1], axes[1]) = e[1];
+                        // The table's r points away from the quarter on both axes; here r_a has the sign -towards[a].
+                        m(axes[0], axes[1]) = m(axes[1], axes[0]) = towards[0] * towards[1] * e[3];
                         sum -= sign * (m * gl);
                       });
   return (k.rotation * sum).template head<Dim>();

@@ -65,7 +65,7 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
   xsphC_ = static_cast<float>(s.xsph_c);
   warmStart_ = static_cast<float>(s.warm_start);
   // The acceleration only when iterating to a tolerance with room for it (see solveDensityConstraints).
-  chebyshevRho_ = s.max_density_error > 0 && s.iterations >= kChebyshevLeastIterations
+  chebyshevRho_ = s.max_density_error > 0 && s.iterations >= SolverSettings::kChebyshevLeastIterations
                       ? static_cast<float>(s.chebyshev_rho)
                       : 0.0f;
   iterations_ = s.iterations;
@@ -182,9 +182,10 @@ void PbfSolver<Dim>::findNeighbors() {
 // It runs only when the loop iterates to solver.max_density_error. After a fixed handful of iterations its
 // polynomial leaves up to 1 / T_k(1 / rho) of the most local errors (19% at 4 iterations, rho = 0.85), which one
 // plain Jacobi iteration clears: a deep pool at the default 4 iterations stirred itself to 0.14 m/s RMS, against
-// 0.03 m/s without it. A tolerance that solver.iterations cuts short is the same case: a resting 3D pool (0.6 x 0.3
-// x 0.6 m, spacing 0.02) iterated to 0.3% moved at 0.28 m/s RMS where the cap of 4 stopped every step, 0.09 m/s
-// at a cap of 6 and 0.05 m/s at 8, as plain Jacobi's 0.054 m/s; so it needs a cap of kChebyshevLeastIterations.
+// 0.03 m/s without it. A tolerance that solver.iterations cuts short is the same case: a resting 3D pool
+// (0.6 x 0.3 x 0.6 m, spacing 0.02) iterated to 0.3% moved at 0.28 m/s RMS where the cap of 4 stopped every
+// step, 0.09 m/s at a cap of 6 and 0.05 m/s at 8, as plain Jacobi's 0.054 m/s; so it needs a cap of
+// SolverSettings::kChebyshevLeastIterations.
 template <int Dim>
 void PbfSolver<Dim>::solveDensityConstraints() {
   const auto start = PhaseClock::now();

@@ -4,7 +4,8 @@
 //   findNeighbors           lines 5-7   sort into the grid, reorder particles, build neighbour lists
 //   solveDensityConstraints lines 8-19  a warm start (below), then Jacobi iterations: lambda (eq. 11), delta p
 //                                       with s_corr (eq. 12-14), collision response, x* += delta p; the
-//                                       iterations are Chebyshev-accelerated (Wang 2015, see the .cpp)
+//                                       iterations are Chebyshev-accelerated when they run to a density
+//                                       error under a cap of 8 or more (Wang 2015, see the .cpp)
 //   updateVelocities        line 21     v = (x* - x) / dt
 //   vorticity + XSPH        line 22     vorticity confinement (eq. 15-16), XSPH viscosity (eq. 17)
 //   commit                  line 23     x = x*
@@ -109,7 +110,6 @@ class PbfSolver final : public FluidSolver<Dim> {
   float vorticityEpsilon_, xsphC_;
   float warmStart_;
   float chebyshevRho_;  // 0: plain Jacobi
-  static constexpr int kChebyshevLeastIterations = 8;  // the accelerated loop's smallest cap (solver.iterations)
   int iterations_;
   double maxDensityError_;
   VecD gravity_;

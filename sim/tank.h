@@ -199,10 +199,9 @@ class TankWalls {
   // above): its weight sum w and its gradient's magnitudes towards each wall, ga and gb. False (and nothing
   // written) when either wall is beyond the support.
   bool edgeTerms(float da, float db, float& w, float& ga, float& gb) const {
-    const float u = std::max(da, 0.0f) * edgeScale_, u2 = std::max(db, 0.0f) * edgeScale_;
-    if (!(u < kEdgeTableSize) || !(u2 < kEdgeTableSize)) return false;  // also NaN
-    const int t = static_cast<int>(u), t2 = static_cast<int>(u2);
-    const float f = u - t, f2 = u2 - t2;
+    int t, t2;
+    float f, f2;
+    if (!edgeCell(da, db, t, t2, f, f2)) return false;
     auto at = [&](int a, int b) { return edge_[a * (kEdgeTableSize + 1) + b]; };
     const EdgeEntry e00 = at(t, t2), e01 = at(t, t2 + 1), e10 = at(t + 1, t2), e11 = at(t + 1, t2 + 1);
     auto blend = [&](float EdgeEntry::*field) {
@@ -216,10 +215,9 @@ class TankWalls {
 
   // The same quarter's moments (EdgeEntry::moments), bilinear in the table; false beyond the support.
   bool edgeMoments(float da, float db, float m[4]) const {
-    const float u = std::max(da, 0.0f) * edgeScale_, u2 = std::max(db, 0.0f) * edgeScale_;
-    if (!(u < kEdgeTableSize) || !(u2 < kEdgeTableSize)) return false;
-    const int t = static_cast<int>(u), t2 = static_cast<int>(u2);
-    const float f = u - t, f2 = u2 - t2;
+    int t, t2;
+    float f, f2;
+    if (!edgeCell(da, db, t, t2, f, f2)) return false;
     auto at = [&](int a, int b) -> const EdgeEntry& { return edge_[a * (kEdgeTableSize + 1) + b]; };
     for (int k = 0; k < 4; ++k)
       m[k] = (1 - f) * ((1 - f2) * at(t, t2).moments[k] + f2 * at(t, t2 + 1).moments[k]) +
@@ -329,6 +327,18 @@ class TankWalls {
       moments[3] = crossMoment;
     }
     return w;
+  }
+
+  // Where distances da and db fall in the edge table: the cell (t, t2) and the fractions (f, f2) across it;
+  // false when either is beyond the support (or NaN).
+  bool edgeCell(float da, float db, int& t, int& t2, float& f, float& f2) const {
+    const float u = std::max(da, 0.0f) * edgeScale_, u2 = std::max(db, 0.0f) * edgeScale_;
+    if (!(u < kEdgeTableSize) || !(u2 < kEdgeTableSize)) return false;
+    t = static_cast<int>(u);
+    t2 = static_cast<int>(u2);
+    f = u - t;
+    f2 = u2 - t2;
+    return true;
   }
 
   // The corners' share of add(): the eighth beyond three walls, for every corner whose three walls are all
