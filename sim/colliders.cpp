@@ -244,15 +244,8 @@ typename Colliders<Dim>::VecD Colliders<Dim>::boxHydrostaticSum(const Placed& k,
                           return;
                         }
                         // An edge's quarter; a corner's eighth has no tabulated moments (docs/colliders.md).
-                        float e[4];
-                        if (walls != 2 || !tank_->edgeMoments(distances[0], distances[1], e)) return;
-                        Eigen::Matrix3f m = Eigen::Matrix3f::Zero();
-                        for (int a = 0; a < Dim; ++a) m(a, a) = e[2];  // along the edge
-                        m(axes[0], axes[0]) = e[0];
-                        m(axes[1], axes[1]) = e[1];
-                        // The table's r points away from the quarter on both axes; here r_a has the sign -towards[a].
-                        m(axes[0], axes[1]) = m(axes[1], axes[0]) = towards[0] * towards[1] * e[3];
-                        sum -= sign * (m * gl);
+                        if (walls == 2)
+                          sum += sign * tank_->edgeHydrostaticSum(distances[0], distances[1], axes, towards, gl);
                       });
   return (k.rotation * sum).template head<Dim>();
 }

@@ -171,6 +171,49 @@ class TankWalls {
     if constexpr (Dim == 3) addCorners(p, weight, gradient);
   }
 
+  // The walls' share of sum_b (g . (x_b - x_i)) grad W(x_i - x_b): WCSPH's wall pressure continued
+  // hydrostatically into the walls, as a collider's (Colliders::hydrostaticSum). Faces less the edges' quarters,
+  // as add() counts them; a corner's eighth has no tabulated moments and is left out, as at a box collider's.
+  VecD hydrostaticSum(const VecD& p, const VecD& g) const {
+    VecD sum = VecD::Zero();
+    if ((p.array() > interiorMin_.array()).all() && (p.array() < interiorMax_.array()).all()) return sum;
+    float d[Dim][2];
+    bool near[Dim][2];
+    const float support = kTableSize / flat_.scale;
+    for (int k = 0; k < Dim; ++k)
+      for (int side = 0; side < 2; ++side) {
+        d[k][side] = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
+        near[k][side] = d[k][side] < support;
+        if (near[k][side]) sum += flat_.hydrostaticSum(d[k][side], VecD(VecD::Unit(k)), g);
+      }
+    for (int k = 0; k < Dim; ++k)
+      for (int k2 = k + 1; k2 < Dim; ++k2)
+        for (int sides = 0; sides < 4; ++sides) {
+          const int side = sides & 1, side2 = sides >> 1;
+          if (!near[k][side] || !near[k2][side2]) continue;
+          const int axes[2] = {k, k2};
+          const float towards[2] = {side ? 1.0f : -1.0f, side2 ? 1.0f : -1.0f};
+          sum -= edgeHydrostaticSum(d[k][side], d[k2][side2], axes, towards, g);
+        }
+    return sum;
+  }
+
+  // The quarter beyond two perpendicular walls at distances da and db, lying along towards[0] on axis axes[0]
+  // and towards[1] on axes[1] (+1 or -1): its sum_b (g . (x_b - x_i)) grad W = -M g, with
+  // M = sum_b (W'(r) / r) r r^T (r = x_i - x_b) from the edge table's moments. Zero beyond the support.
+  template <typename Vector>
+  Vector edgeHydrostaticSum(float da, float db, const int axes[2], const float towards[2], const Vector& g) const {
+    constexpr int n = Vector::RowsAtCompileTime;
+    float e[4];
+    if (!edgeMoments(da, db, e)) return Vector::Zero();
+    Eigen::Matrix<float, n, n> m = Eigen::Matrix<float, n, n>::Identity() * e[2];  // along the edge
+    m(axes[0], axes[0]) = e[0];
+    m(axes[1], axes[1]) = e[1];
+    // The table's r points away from the quarter on both axes; here r_a has the sign -towards[a].
+    m(axes[0], axes[1]) = m(axes[1], axes[0]) = towards[0] * towards[1] * e[3];
+    return -(m * g);
+  }
+
   // The share of one flat wall at distance d (the table above): see FlatWallTable.
   const FlatWallTable& flatWall() const { return flat_; }
 

@@ -205,11 +205,12 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
           nearForce += ((nearPressure_[i] + nearPressure_[*j]) * d * d * inverseSupport / length) * r;
         }
       }
-      // The walls as mirrored particles with this particle's pressure.
+      // The walls as mirrored particles with this particle's pressure continued hydrostatically, as the
+      // colliders' below (TankWalls::hydrostaticSum).
       float unusedWeight = 0;
       VecD wallGradient = VecD::Zero();
       walls_.add(x_[i], unusedWeight, wallGradient);
-      pressureForce -= 2.0f * pressureTermI * wallGradient;
+      pressureForce -= 2.0f * pressureTermI * wallGradient + (1.0f / density_[i]) * walls_.hydrostaticSum(x_[i], gravity_);
       // The colliders likewise, their pressure continued hydrostatically (Colliders::hydrostaticSum); each
       // one's share is a force on the particle, recorded for colliders.csv.
       if (!colliders_.empty())

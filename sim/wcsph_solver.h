@@ -4,7 +4,9 @@
 //   density by summation     rho_i = sum_j m W_ij (+ the walls, sim/tank.h)
 //   equation of state        Tait p = rho_0 c^2 / 7 ((rho / rho_0)^7 - 1), or the gas law p = k (rho - rho_0);
 //                            negative pressures are clamped to 0 so the free surface does not pull together
-//   symmetric pressure force a_i = -sum_j m (p_i / rho_i^2 + p_j / rho_j^2) grad W_ij
+//   symmetric pressure force a_i = -sum_j m (p_i / rho_i^2 + p_j / rho_j^2) grad W_ij, the walls' and the
+//                            colliders' pressure continued from p_i by the hydrostatic gradient (Adami et al.
+//                            2012, eq. 27; TankWalls::hydrostaticSum, Colliders::hydrostaticSum)
 //   viscosity                artificial (Monaghan 1992): Pi_ij = -alpha c h mu_ij / rho_ij for approaching pairs,
 //                            mu_ij = v_ij . x_ij / (|x_ij|^2 + 0.01 h^2); laminar (Morris et al. 1997):
 //                            a_i += 2 (d + 2) nu sum_j (m / rho_j) mu_ij grad W_ij

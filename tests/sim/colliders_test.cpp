@@ -342,12 +342,15 @@ TEST(Colliders, BoxOnTheFloorCarriesTheWaterAboveWcsph) { checkBoxOnTheFloor<Wcs
 // (its compression under 4 x 4 iterations, measured on this pool), so rho is taken as the mean density of the
 // water, the particles' mass over the volume they fill (up to the mean surface height), and the force must
 // match rho g V within 5%, the sideways force within 1% of it.
-// The pool never stops sloshing: the sphere's removed particles and round-off break its symmetry (how, depends on
-// the build's floating point), and the sideways force swings by 5-10% of rho g V from frame to frame (measured
-// on the WCSPH pool: +-15 N against rho g V = 199 N, its half-second means from -8 to +9 N). A mean over a few
-// seconds is then itself uncertain by the noise: the sideways check is that the mean lies within three standard
-// errors of zero (the errors from the means of half-second blocks, longer than the swings), and the check must
-// have the power to see a bias of 2% of rho g V (three standard errors under it), else the window is too short.
+// Sideways, the force should vanish, but it need not: the sphere's removed particles and round-off break the
+// pool's symmetry (how, depends on the build's floating point). PBF's pool never stops sloshing, and its sideways
+// force swings by 5-10% of rho g V from frame to frame; WCSPH's comes to rest, in an arrangement that is not
+// mirror-symmetric at the grain of one particle and holds a steady sideways force (measured: 2.3 N/m in 2D, 1.1%
+// of rho g V and 0.6 of one particle's weight; 0.1 N in 3D, 0.5%). So the sideways check is that the mean lies
+// under 2% of rho g V, and the window must have the power to see that (three standard errors of the mean under
+// it, the errors from the means of half-second blocks, longer than the swings), else it is too short. This sees
+// the pool's symmetry more than the wall's: at rest the water stands off a wall that pushes too hard, so a ball
+// whose wall term was made 10% stronger on one side still read -2.3 N/m in 2D (tried).
 template <int Dim, typename Solver>
 void checkBuoyancy(const Scene& scene, double sphereVolume, double settle, double watch, double tolerance = 0.05) {
   Solver solver(scene);
@@ -382,7 +385,7 @@ void checkBuoyancy(const Scene& scene, double sphereVolume, double settle, doubl
   const double rho = solver.size() * solver.particleMass() / (surface * footprint - sphereVolume);
   const double archimedes = rho * 9.81 * sphereVolume;
   EXPECT_NEAR(w.force.y(), archimedes, tolerance * archimedes) << "rho = " << rho;
-  EXPECT_LT(std::abs(w.force.x()), 3 * standardError) << "a sideways bias beyond the sloshing's noise";
+  EXPECT_LT(std::abs(w.force.x()), 0.02 * archimedes) << "a sideways bias";
   EXPECT_LT(3 * standardError, 0.02 * archimedes) << "the window is too short to see a 2% sideways bias";
   std::printf("buoyancy %dD: F = (%.4f, %.4f) N over %.1f s, standard error of F_x %.3f N, rho g V = %.4f N "
               "(rho %.1f)\n", Dim, w.force.x(), w.force.y(), watch, standardError, archimedes, rho);
@@ -408,6 +411,19 @@ TEST(Colliders, SubmergedSphereFeelsArchimedesWcsph) {
                                 R"([{"shape": "sphere", "position": [0.3, 0.2], "radius": 0.08}])", 0.02,
                                 {"solver.method=wcsph"});
   checkBuoyancy<2, WcsphSolver<2>>(scene, M_PI * 0.08 * 0.08, 2.5, 8.0);
+}
+
+// The same ball as PBF's, in 3D. WCSPH reads it +4.0% over rho g V (rho the water's mean; measured over 2.5-10 s,
+// and the same in a pool 0.5 m wide), once the tank's walls continue the pressure hydrostatically as the ball
+// does (TankWalls::hydrostaticSum); with the walls mirroring the particle's pressure it read +15.5%: the water
+// beside the walls missed the walls' share of its support and the pressure below the ball rose 13% over
+// hydrostatic (docs/colliders.md).
+TEST(Colliders, SubmergedSphereFeelsArchimedesWcsph3d) {
+  const Scene scene = makeScene(3, R"({"min": [0, 0, 0], "max": [0.3, 0.6, 0.3]})",
+                                R"([{"box": {"min": [0, 0, 0], "max": [0.3, 0.4, 0.3]}}])",
+                                R"([{"shape": "sphere", "position": [0.15, 0.2, 0.15], "radius": 0.08}])", 0.02,
+                                {"solver.method=wcsph"});
+  checkBuoyancy<3, WcsphSolver<3>>(scene, 4.0 / 3.0 * M_PI * std::pow(0.08, 3), 2.5, 4.0);
 }
 
 // The force bookkeeping is exact where the model is: a plane laid as the tank's floor carries all the water's
