@@ -1,5 +1,6 @@
 // surge sim SCENE: simulate a scene into particle frames and stats.csv.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -70,7 +71,22 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   const std::shared_ptr<const ColliderShapes> shapes = buildColliderShapes(scene);
   for (const ColliderShape& shape : *shapes)
     if (!shape.note.empty()) say(options, "sim: " + shape.note);
-  if (!scene.bodies.empty()) RigidBodies check(scene, shapes);
+  if (!scene.bodies.empty()) {
+    const RigidBodies check(scene, shapes);
+    // The coupling is explicit (docs/bodies.md): one particle's push in one step can throw a body lighter than it.
+    const double particleMass = scene.solver.rest_density * std::pow(scene.particle_spacing, scene.dimensions);
+    for (size_t b = 0; b < check.size(); ++b) {
+      const double mass = check.massProperties(b).mass;
+      if (!(mass < particleMass)) continue;
+      const char* unit = scene.dimensions == 2 ? " kg/m" : " kg";
+      char line[320];
+      std::snprintf(line, sizeof line,
+                    "sim: note: body %s (%.3g%s) is lighter than one fluid particle (%.3g%s): the water may throw "
+                    "it; a finer particle_spacing or a heavier body holds it (docs/bodies.md)",
+                    scene.bodies[b].solid.name.c_str(), mass, unit, particleMass, unit);
+      say(options, line);
+    }
+  }
   if (scene.solver.method == "pbf" && stableSubsteps(scene) > scene.solver.substeps)
     say(options, "sim: note: solver.substeps " + std::to_string(scene.solver.substeps) + " is below the " +
                      std::to_string(stableSubsteps(scene)) +

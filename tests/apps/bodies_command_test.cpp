@@ -64,6 +64,29 @@ TEST(BodiesCommand, SameBytesAtOneAndTwoThreadsAndAfterResume) {
   EXPECT_GT(c6.x(), 0.15f + 0.05f);                // and moved along x
 }
 
+// A body lighter than one fluid particle is simulated, with one line saying the water may throw it (the explicit
+// coupling's limit, docs/bodies.md); the scene's own bodies, 15 g of particle against 96 g and more, say nothing.
+TEST(BodiesCommand, ABodyLighterThanAParticleIsNoted) {
+  std::string text = kBodies;
+  const size_t start = text.find("\"bodies\""), end = text.find("\"output\"");
+  text.replace(start, end - start,
+               R"("bodies": [{"name": "cork", "shape": "box", "size": [0.04, 0.04, 0.04], "position": [0.3, 0.3, 0.2],
+                 "density": 20}],
+  )");
+  const size_t frames = text.find("\"frames\": 6");
+  text.replace(frames, 11, "\"frames\": 1");
+  const fs::path out = freshFolder("cork_out");
+  const SurgeResult r = runSurge("sim '" + writeTestScene("cork.json", text).string() + "' --out " + out.string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("sim: note: body cork (0.00128 kg) is lighter than one fluid particle (0.0156 kg)"),
+            std::string::npos)
+      << r.out;
+  const SurgeResult quiet = runSurge("sim '" + writeTestScene("drop.json", kBodies).string() + "' --out " +
+                                     freshFolder("drop_note_out").string() + " --set output.frames=1");
+  EXPECT_EQ(quiet.status, 0) << quiet.err;
+  EXPECT_EQ(quiet.out.find("lighter than one fluid particle"), std::string::npos) << quiet.out;
+}
+
 // Each bad body input: one line naming the scene file and the key, exit 2, and no output folder.
 TEST(BodiesCommand, BadInputIsOneLineAndWritesNothing) {
   const std::string dir = testing::TempDir();
