@@ -153,6 +153,54 @@ TEST(Bodies, HeavySphereSinksAndStaysDown) {
   }
 }
 
+// Contacts are Bullet's, between bodies, colliders and the tank, with the bodies' Coulomb friction, in a tank
+// whose water is a small block in a corner, away from them. A box stacked on a box on the floor rests there: the
+// lower's centre half its height above the floor, the upper's the two half heights above that, within 3 mm
+// (Bullet's contact margin is a tenth of the spacing, 2 mm, and a resting contact sinks into it). Two cubes on
+// a ramp (a box collider tilted 20 degrees, tan 20 = 0.36): at friction 1 one stays put, at 0 the other slides
+// as down a frictionless slope, g sin 20 t^2 / 2 = 0.151 m in 0.3 s, within 10% (the contact's start-up).
+TEST(Bodies, ContactsStackAndFrictionHoldsOnASlope) {
+  const double angle = 20 * M_PI / 180;
+  const Eigen::Vector3d rampCentre(0.3, 0.15, 0.15), normal(-std::sin(angle), std::cos(angle), 0);
+  auto onRamp = [&](double z) {
+    const Eigen::Vector3d c = rampCentre + (0.02 + 0.025 + 0.001) * normal + Eigen::Vector3d(0, 0, z - 0.15);
+    return "[" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) + "]";
+  };
+  const std::string tilt = R"("rotation": {"axis": [0, 0, 1], "degrees": 20})";
+  Scene scene = parseScene(
+      R"({"name": "contacts", "dimensions": 3, "domain": {"min": [0, 0, 0], "max": [0.6, 0.5, 0.6]},
+          "particle_spacing": 0.02, "fluids": [{"box": {"min": [0, 0, 0.5], "max": [0.1, 0.04, 0.6]}}],
+          "colliders": [{"name": "ramp", "shape": "box", "position": [0.3, 0.15, 0.15], "size": [0.3, 0.04, 0.2], )" +
+          tilt + R"(}],
+          "bodies": [
+            {"name": "lower", "shape": "box", "position": [0.45, 0.032, 0.45], "size": [0.12, 0.06, 0.12],
+             "density": 800, "friction": 0.5},
+            {"name": "upper", "shape": "box", "position": [0.45, 0.094, 0.45], "size": [0.08, 0.06, 0.08],
+             "density": 800, "friction": 0.5},
+            {"name": "sticky", "shape": "box", "position": )" + onRamp(0.1) + R"(, "size": [0.05, 0.05, 0.05], )" +
+          tilt + R"(, "density": 800, "friction": 1},
+            {"name": "slippery", "shape": "box", "position": )" + onRamp(0.2) + R"(, "size": [0.05, 0.05, 0.05], )" +
+          tilt + R"(, "density": 800, "friction": 0}],
+          "output": {"fps": 30, "frames": 9}})",
+      "test");
+  const fs::path dir = runScene(scene);
+  const std::vector<BodyRow> lower = readBodies(dir, "lower"), upper = readBodies(dir, "upper");
+  const std::vector<BodyRow> sticky = readBodies(dir, "sticky"), slippery = readBodies(dir, "slippery");
+  ASSERT_EQ(lower.size(), 10u);
+  EXPECT_NEAR(lower.back().position.y(), 0.03, 0.003);
+  EXPECT_NEAR(upper.back().position.y() - lower.back().position.y(), 0.06, 0.003);
+  EXPECT_NEAR(upper.back().position.x(), 0.45, 0.003);  // still on top
+  const Eigen::Vector3d downhill(-std::cos(angle), -std::sin(angle), 0);
+  const double stuck = (sticky.back().position - sticky.front().position).norm();
+  const double slid = (slippery.back().position - slippery.front().position).dot(downhill);
+  const double frictionless = 0.5 * 9.81 * std::sin(angle) * 0.3 * 0.3;
+  std::printf("stack: lower at %.4f m, upper %.4f m above it; on the ramp: friction 1 moved %.4f m, friction 0 "
+              "slid %.4f m (frictionless %.4f m)\n", lower.back().position.y(),
+              upper.back().position.y() - lower.back().position.y(), stuck, slid, frictionless);
+  EXPECT_LT(stuck, 0.002);
+  EXPECT_NEAR(slid, frictionless, 0.1 * frictionless);
+}
+
 // A box of relative density 0.5 released deep (its bottom 3 spacings above the floor, so water lies under it:
 // a box flat on the floor with none under it feels no pressure from below, as in a real tank) rises and
 // surfaces: its top comes above the water.
