@@ -210,7 +210,8 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
       float unusedWeight = 0;
       VecD wallGradient = VecD::Zero();
       walls_.add(x_[i], unusedWeight, wallGradient);
-      pressureForce -= 2.0f * pressureTermI * wallGradient + (1.0f / density_[i]) * walls_.hydrostaticSum(x_[i], gravity_);
+      pressureForce -= 2.0f * pressureTermI * wallGradient +
+                       (1.0f / density_[i]) * walls_.hydrostaticSum(x_[i], gravity_);
       // The colliders likewise, their pressure continued hydrostatically (Colliders::hydrostaticSum); each
       // one's share is a force on the particle, recorded for colliders.csv.
       if (!colliders_.empty())
