@@ -109,9 +109,9 @@ void Colliders<Dim>::beginStep(double time, float dt) {
     const float grow = support_ + radius_;
     k.near = Eigen::AlignedBox<float, Dim>(world.min().template head<Dim>() - Vec<Dim>::Constant(grow),
                                            world.max().template head<Dim>() + Vec<Dim>::Constant(grow));
-    // Bodies keep the flat wall: with a box's exact edges, a heavy box resting on a trapped layer of water
-    // rocked at the default 4 x 4 (docs/bodies.md).
-    if (shape.kind == ShapeKind::Box && !shape.container && !body) placeBox(k);
+    // A box, collider or body, is counted exactly (a body kept the flat wall while a heavy box rested on a
+    // trapped layer of water, which no longer forms: docs/bodies.md).
+    if (shape.kind == ShapeKind::Box && !shape.container) placeBox(k);
   }
   buildGrid();
 }
