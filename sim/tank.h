@@ -142,33 +142,28 @@ class TankWalls {
 
   // Adds the walls' share of sum_b W(p - p_b) to `weight` and of sum_b grad W(p - p_b) to `gradient`.
   void add(const VecD& p, float& weight, VecD& gradient) const {
-    if ((p.array() > interiorMin_.array()).all() && (p.array() < interiorMax_.array()).all()) return;
-    for (int k = 0; k < Dim; ++k)
-      for (int side = 0; side < 2; ++side) {
-        const float d = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
-        const float u = std::max(d, 0.0f) * flat_.scale;
-        if (!(u < kTableSize)) continue;  // also skips NaN
-        const int t = static_cast<int>(u);
-        const float f = u - t;
-        weight += (1 - f) * flat_.weight[t] + f * flat_.weight[t + 1];
-        const float g = (1 - f) * flat_.gradient[t] + f * flat_.gradient[t + 1];
-        gradient[k] += side == 0 ? -g : g;  // grad_{p_i} points towards the wall
-      }
-    // Edges: the quarter beyond two walls was added by each; take it away once. Corners: the eighth beyond
+    // Edges: the quarter beyond two walls was added by each face; take it away once. Corners: the eighth beyond
     // three walls was added three times and taken away three times; add it once (inclusion-exclusion).
-    for (int k = 0; k < Dim; ++k)
-      for (int k2 = k + 1; k2 < Dim; ++k2)
-        for (int sides = 0; sides < 4; ++sides) {
-          const int side = sides & 1, side2 = sides >> 1;
-          const float d = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
-          const float d2 = side2 == 0 ? p[k2] - domainMin_[k2] : domainMax_[k2] - p[k2];
+    const bool nearAWall = forEachFaceAndEdge(
+        p,
+        [&](int k, int side, float d) {
+          const float u = std::max(d, 0.0f) * flat_.scale;
+          if (!(u < kTableSize)) return;  // also skips NaN
+          const int t = static_cast<int>(u);
+          const float f = u - t;
+          weight += (1 - f) * flat_.weight[t] + f * flat_.weight[t + 1];
+          const float g = (1 - f) * flat_.gradient[t] + f * flat_.gradient[t + 1];
+          gradient[k] += side == 0 ? -g : g;  // grad_{p_i} points towards the wall
+        },
+        [&](const int axes[2], const int sides[2], const float d[2]) {
           float w, ga, gb;
-          if (!edgeTerms(d, d2, w, ga, gb)) continue;
+          if (!edgeTerms(d[0], d[1], w, ga, gb)) return;
           weight -= w;
-          gradient[k] -= side == 0 ? -ga : ga;
-          gradient[k2] -= side2 == 0 ? -gb : gb;
-        }
-    if constexpr (Dim == 3) addCorners(p, weight, gradient);
+          gradient[axes[0]] -= sides[0] == 0 ? -ga : ga;
+          gradient[axes[1]] -= sides[1] == 0 ? -gb : gb;
+        });
+    if constexpr (Dim == 3)
+      if (nearAWall) addCorners(p, weight, gradient);
   }
 
   // The walls' share of sum_b (g . (x_b - x_i)) grad W(x_i - x_b): WCSPH's wall pressure continued
@@ -176,25 +171,12 @@ class TankWalls {
   // as add() counts them; a corner's eighth has no tabulated moments and is left out, as at a box collider's.
   VecD hydrostaticSum(const VecD& p, const VecD& g) const {
     VecD sum = VecD::Zero();
-    if ((p.array() > interiorMin_.array()).all() && (p.array() < interiorMax_.array()).all()) return sum;
-    float d[Dim][2];
-    bool near[Dim][2];
-    const float support = kTableSize / flat_.scale;
-    for (int k = 0; k < Dim; ++k)
-      for (int side = 0; side < 2; ++side) {
-        d[k][side] = side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k];
-        near[k][side] = d[k][side] < support;
-        if (near[k][side]) sum += flat_.hydrostaticSum(d[k][side], VecD(VecD::Unit(k)), g);
-      }
-    for (int k = 0; k < Dim; ++k)
-      for (int k2 = k + 1; k2 < Dim; ++k2)
-        for (int sides = 0; sides < 4; ++sides) {
-          const int side = sides & 1, side2 = sides >> 1;
-          if (!near[k][side] || !near[k2][side2]) continue;
-          const int axes[2] = {k, k2};
-          const float towards[2] = {side ? 1.0f : -1.0f, side2 ? 1.0f : -1.0f};
-          sum -= edgeHydrostaticSum(d[k][side], d[k2][side2], axes, towards, g);
-        }
+    forEachFaceAndEdge(
+        p, [&](int k, int, float d) { sum += flat_.hydrostaticSum(d, VecD(VecD::Unit(k)), g); },
+        [&](const int axes[2], const int sides[2], const float d[2]) {
+          const float towards[2] = {sides[0] ? 1.0f : -1.0f, sides[1] ? 1.0f : -1.0f};
+          sum -= edgeHydrostaticSum(d[0], d[1], axes, towards, g);
+        });
     return sum;
   }
 
@@ -370,6 +352,30 @@ class TankWalls {
       moments[3] = crossMoment;
     }
     return w;
+  }
+
+  // Calls face(k, side, d) for each wall (axis k, side 0 at domainMin, 1 at domainMax) at distance d from p,
+  // then edge(axes, sides, d) for each pair of walls on distinct axes, in the order add() has always summed
+  // them; false (and no call) for a particle farther than the support from every wall. Each call decides for
+  // itself what is beyond the support (the tables read 0 there).
+  template <typename Face, typename Edge>
+  bool forEachFaceAndEdge(const VecD& p, Face&& face, Edge&& edge) const {
+    if ((p.array() > interiorMin_.array()).all() && (p.array() < interiorMax_.array()).all()) return false;
+    float d[Dim][2];
+    for (int k = 0; k < Dim; ++k) {
+      d[k][0] = p[k] - domainMin_[k];
+      d[k][1] = domainMax_[k] - p[k];
+    }
+    for (int k = 0; k < Dim; ++k)
+      for (int side = 0; side < 2; ++side) face(k, side, d[k][side]);
+    for (int k = 0; k < Dim; ++k)
+      for (int k2 = k + 1; k2 < Dim; ++k2)
+        for (int both = 0; both < 4; ++both) {
+          const int axes[2] = {k, k2}, sides[2] = {both & 1, both >> 1};
+          const float at[2] = {d[k][sides[0]], d[k2][sides[1]]};
+          edge(axes, sides, at);
+        }
+    return true;
   }
 
   // Where distances da and db fall in the edge table: the cell (t, t2) and the fractions (f, f2) across it;
