@@ -1,13 +1,14 @@
 // The rigid bodies' share of a step (issue: rigid bodies), printed as a markdown table for docs/performance.md:
 // 10 bodies (boxes and balls at half the water's density) floating in a pool of about 100,000 particles,
 // stepped coupled (Bullet's step, the bodies' colliders, their forces; Bullet's world rebuilt every frame as the
-// frame loop does) and then, from the very same particle state, without bodies. The share is
-// 1 - t_without / t_with, both timed in this process, alternating, best of several rounds.
+// frame loop does) and, from the very same particle state, without bodies. The share is 1 - t_without / t_with,
+// both timed in this process, a frame each in turn, the median over the rounds (bench/bench_timing.h).
 // Run: build/bench/surge_bench_bodies [threads]   (default: all cores)
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <vector>
 
 #include "bench/bench_timing.h"
 #include "core/parallel.h"
@@ -82,23 +83,28 @@ int main(int argc, char** argv) {
   coupledFrames(6);  // the bodies settle onto the water
   const Scene withoutBodies = pool("[]");
   PbfSolver<3> without(withoutBodies);
-  double bestWith = 1e30, bestWithout = 1e30;
-  for (int round = 0; round < 4; ++round) {
+  // A frame without the bodies, from the coupled pool's state, then a frame with them, twelve times in turn.
+  constexpr int kRounds = 12;
+  std::vector<double> withTimes, withoutTimes;
+  for (int round = 0; round < kRounds; ++round) {
     ParticleFrame state;
     with.getParticles(state);
     without.setParticles(state);
     double t0 = time;
     const auto start = BenchClock::now();
-    for (int s = 0; s < 2 * substeps; ++s, t0 += dt) without.step(dt, t0);
-    bestWithout = std::min(bestWithout, secondsSince(start) / (2 * substeps));
-    bestWith = std::min(bestWith, coupledFrames(2));
+    for (int s = 0; s < substeps; ++s, t0 += dt) without.step(dt, t0);
+    withoutTimes.push_back(secondsSince(start) / substeps);
+    withTimes.push_back(coupledFrames(1));
   }
+  const StepShare measured = stepShare(withTimes, withoutTimes);
   std::printf("| measure | value |\n|---|---|\n");
   std::printf("| threads | %d |\n", threads > 0 ? threads : ThreadLimit::available());
   std::printf("| particles | %zu |\n", with.size());
   std::printf("| bodies | %zu |\n", bodies.size());
-  std::printf("| PBF step with the bodies (coupled, Bullet, world rebuilt each frame) | %.1f ms |\n", 1e3 * bestWith);
-  std::printf("| PBF step, same particles, no bodies | %.1f ms |\n", 1e3 * bestWithout);
-  std::printf("| bodies' share of a step | %.1f%% |\n", 100 * (1 - bestWithout / bestWith));
+  std::printf("| PBF step with the bodies (coupled, Bullet, world rebuilt each frame; median) | %.1f ms |\n",
+              1e3 * measured.with);
+  std::printf("| PBF step, same particles, no bodies (median) | %.1f ms |\n", 1e3 * measured.without);
+  std::printf("| bodies' share of a step (median of %d rounds; quartiles) | %.1f%% (%.1f%% - %.1f%%) |\n", kRounds,
+              100 * measured.share, 100 * measured.lowQuartile, 100 * measured.highQuartile);
   return 0;
 }

@@ -2,8 +2,8 @@
 //  - baking a mesh of 100,000 triangles (a torus) into its distance field, as `surge sim` does when it reads
 //    the scene (read the OBJ, check it is closed, OpenVDB's mesh to volume, copy to the dense grid), wall time;
 //  - the colliders' share of a PBF step: 100,000 particles in a pool with that torus lying in the water, stepped
-//    with the collider and then, from the very same particle state, without it; the share is 1 - t_without /
-//    t_with, both timed in this process, alternating, best of several rounds;
+//    with the collider and, from the very same particle state, without it; the share is 1 - t_without /
+//    t_with, both timed in this process, four steps each in turn, the median over the rounds;
 //  - the memory the collider holds.
 // Run: build/bench/surge_bench_colliders [threads]   (default: all cores)
 #include <chrono>
@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <vector>
 
 #include "bench/bench_timing.h"
 #include "core/parallel.h"
@@ -83,16 +84,19 @@ int main(int argc, char** argv) {
   timeSteps(with, 24, time);  // settle a little: the water presses on the torus
   const Scene withoutMesh = pool("[]");
   PbfSolver<3> without(withoutMesh);
-  double bestWith = 1e30, bestWithout = 1e30;
-  for (int round = 0; round < 4; ++round) {
+  // Four steps without the collider from the pool's state, then four with it, twelve times in turn.
+  constexpr int kRounds = 12;
+  std::vector<double> withTimes, withoutTimes;
+  for (int round = 0; round < kRounds; ++round) {
     ParticleFrame state;
     with.getParticles(state);
     without.setParticles(state);
     double t0 = time, t1 = time;
-    bestWithout = std::min(bestWithout, timeSteps(without, 8, t0));
-    bestWith = std::min(bestWith, timeSteps(with, 8, t1));
+    withoutTimes.push_back(timeSteps(without, 4, t0));
+    withTimes.push_back(timeSteps(with, 4, t1));
     time = t1;
   }
+  const StepShare measured = stepShare(withTimes, withoutTimes);
   std::printf("| measure | value |\n|---|---|\n");
   std::printf("| threads | %d |\n", threads > 0 ? threads : ThreadLimit::available());
   std::printf("| mesh triangles | %zu |\n", torus.mesh.triangles.size());
@@ -100,9 +104,10 @@ int main(int argc, char** argv) {
   std::printf("| distance grid | %d x %d x %d voxels of %.4f m, %.1f MB |\n", torus.grid.counts()[0],
               torus.grid.counts()[1], torus.grid.counts()[2], torus.grid.voxel(), torus.memoryBytes() / 1e6);
   std::printf("| particles | %zu |\n", with.size());
-  std::printf("| PBF step with the torus | %.1f ms |\n", 1e3 * bestWith);
-  std::printf("| PBF step, same particles, no collider | %.1f ms |\n", 1e3 * bestWithout);
-  std::printf("| colliders' share of a step | %.1f%% |\n", 100 * (1 - bestWithout / bestWith));
+  std::printf("| PBF step with the torus (median) | %.1f ms |\n", 1e3 * measured.with);
+  std::printf("| PBF step, same particles, no collider (median) | %.1f ms |\n", 1e3 * measured.without);
+  std::printf("| colliders' share of a step (median of %d rounds; quartiles) | %.1f%% (%.1f%% - %.1f%%) |\n",
+              kRounds, 100 * measured.share, 100 * measured.lowQuartile, 100 * measured.highQuartile);
   fs::remove(obj);
   return 0;
 }

@@ -49,6 +49,10 @@ class ColliderShape {
     Eigen::Vector3f unused;
     return distance(q, unused);
   }
+  // False where distance() is an estimate that a point's distance less how far it moves need not bound (the
+  // heightfield's first-order one, which a curved slope breaks): a solver that would skip a sweep on that bound
+  // must sweep (sim/colliders.h, Colliders::nothingStops).
+  bool distanceBoundsMoves() const { return kind != ShapeKind::Heightfield; }
   // Bytes held (the mesh's distance grid, the heightfield and the drawing mesh).
   size_t memoryBytes() const;
 };

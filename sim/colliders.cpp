@@ -40,7 +40,7 @@ Colliders<Dim>::Colliders(const Scene& scene, std::shared_ptr<const ColliderShap
   // The candidates' grid over the tank.
   for (int k = 0; k < Dim; ++k) {
     const float extent = static_cast<float>(scene.domain.max[k] - scene.domain.min[k]);
-    const float cell = std::max(2 * support_, extent / 64);
+    const float cell = std::max(support_, extent / 64);
     gridCounts_[k] = std::max(1, static_cast<int>(std::ceil(extent / cell)));
     gridMin_[k] = static_cast<float>(scene.domain.min[k]);
     cellInverse_[k] = gridCounts_[k] / extent;
@@ -254,11 +254,10 @@ template <int Dim>
 void Colliders<Dim>::buildGrid() {
   // Each collider is listed in the cells its near box reaches, grown by a margin that covers a short move and
   // the pushes it may take (project).
-  const float margin = (kShortMove + 2 * kShortMove + 2) * radius_;
   size_t cells = 1;
   for (int k = 0; k < Dim; ++k) cells *= size_t(gridCounts_[k]);
   std::vector<uint32_t> count(cells + 1, 0);
-  auto forCells = [&](const Eigen::AlignedBox<float, Dim>& box, auto&& f) {
+  auto forCells = [&](const Eigen::AlignedBox<float, Dim>& box, float margin, auto&& f) {
     Eigen::Array<int, Dim, 1> lo, hi;
     for (int k = 0; k < Dim; ++k) {
       const float a = (box.min()[k] - margin - gridMin_[k]) * cellInverse_[k];
@@ -276,12 +275,17 @@ void Colliders<Dim>::buildGrid() {
           f(index);
         }
   };
-  for (size_t c = 0; c < placed_.size(); ++c) forCells(placed_[c].near, [&](size_t i) { ++count[i + 1]; });
+  const float margin = kGridMargin * radius_;
+  for (size_t c = 0; c < placed_.size(); ++c) forCells(placed_[c].near, margin, [&](size_t i) { ++count[i + 1]; });
   for (size_t i = 0; i < cells; ++i) count[i + 1] += count[i];
   cellStart_ = count;
   cellSolids_.resize(count[cells]);
   for (size_t c = 0; c < placed_.size(); ++c)
-    forCells(placed_[c].near, [&](size_t i) { cellSolids_[count[i]++] = static_cast<uint16_t>(c); });
+    forCells(placed_[c].near, margin, [&](size_t i) { cellSolids_[count[i]++] = static_cast<uint16_t>(c); });
+  // And the cells that no collider reaches (farFrom).
+  cellReached_.assign(cells, 0);
+  for (size_t c = 0; c < placed_.size(); ++c)
+    forCells(placed_[c].near, kFarMargin * radius_, [&](size_t i) { cellReached_[i] = 1; });
 }
 
 template <int Dim>
@@ -323,9 +327,9 @@ bool Colliders<Dim>::sweep(size_t c, const VecD& from, const VecD& p, bool fromS
   if (!std::isfinite(length)) return false;  // a diverged particle is reported, not moved
   const float radius = radius_ / k.scale;
   const ColliderShape& shape = *k.shape;
-  Eigen::Vector3f normal;
+  Eigen::Vector3f normal, endNormal;
   // Every point of the move is at least atEnd - length from the solid (a distance is 1-Lipschitz).
-  const float atEnd = shape.distance(q1, normal);
+  const float atEnd = shape.distance(q1, endNormal);
   if (atEnd >= radius + length) return false;
   // Sphere tracing from q0: steps as long as the distance allows, and at least half a radius. A wall one
   // spacing (two radii) thick has a band four radii deep closer than a radius, which no step can cross. The
@@ -347,18 +351,21 @@ bool Colliders<Dim>::sweep(size_t c, const VecD& from, const VecD& p, bool fromS
     t = std::min(length, t + std::max(d - radius, shortest));
   }
   Eigen::Vector3f target;
+  float landed;  // the distance at target
   if (hit) {
     // Stop on the surface at a radius and keep the rest of the move along it.
     target = at + (radius - d) * normal;
     Eigen::Vector3f rest = q1 - at;
     rest -= rest.dot(normal) * normal;
     target += rest;
+    landed = shape.distance(target, normal);
   } else if (atEnd < radius) {
     target = q1;  // moved off the wall, not yet a radius away: lifted below
+    landed = atEnd;
+    normal = endNormal;
   } else {
     return false;
   }
-  const float landed = shape.distance(target, normal);
   if (landed < radius) target += (radius - landed) * normal;
   const Eigen::Vector3f world = k.translation + k.rotation * (k.scale * target);
   delta = world.head<Dim>() - p;

@@ -21,6 +21,8 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -60,6 +62,10 @@ class Colliders {
   bool empty() const { return placed_.empty(); }
   size_t size() const { return placed_.size(); }
   bool hasFriction() const { return hasFriction_; }
+  // True if some collider or body moves (a distance found at one step then need not hold at the next).
+  bool anyMoving() const {
+    return std::any_of(placed_.begin(), placed_.end(), [](const Placed& k) { return k.moving; });
+  }
 
   // Places the colliders for a step from `time` to `time + dt`, at its end; each wall's velocity is its motion
   // over the step.
@@ -75,14 +81,20 @@ class Colliders {
   // the colliders' order.
   template <typename Visit>
   void forEachNear(const VecD& p, Visit&& visit) const {
-    const uint16_t *c = nullptr, *end = nullptr;
-    candidates(p, c, end);
-    for (; c != end; ++c) {
-      if (!placed_[*c].near.contains(p)) continue;
-      VecD normal;
-      const float d = distance(*c, p, normal);
-      if (d < support_) visit(*c, d, normal);
-    }
+    forEachInReach(p, [&](size_t c, float d, const VecD& n) {
+      if (d < support_) visit(c, d, n);
+    });
+  }
+
+  // True if no collider's near box comes within kFarMargin radii of p's grid cell: forEachNear(p) then finds
+  // nothing, and nothing stops a move to p shorter than kFarReach radii (moveFarFrom; the radius between is
+  // slack for the tank's clamp and for rounding). Most of a pool is that far from its floating bodies.
+  bool farFrom(const VecD& p) const {
+    size_t cell;
+    return cellOf(p, cell) && !cellReached_[cell];
+  }
+  bool moveFarFrom(const VecD& from, const VecD& p) const {
+    return (p - from).squaredNorm() < kFarReach * kFarReach * radius_ * radius_ && farFrom(p);
   }
 
   // Collider c's share of sum_b W(p - p_b) (weight) and sum_b grad_p W(p - p_b) (gradient) at p, at distance d
@@ -112,16 +124,56 @@ class Colliders {
     return tank_->flatWall().hydrostaticSum(d, n, g);
   }
 
-  // Adds every collider's share of the density sums at p (as TankWalls::add does for the tank).
-  void add(const VecD& p, float& weight, VecD& gradient) const {
-    forEachNear(p, [&](size_t c, float d, const VecD& n) {
+  // What add found at p, for a solver that reuses it at the same p (PBF's correction after its lambda pass): a
+  // lower bound on p's distance to every collider (the support when none is nearer; -infinity near a shape
+  // whose distance is an estimate), how many lie within the support, and for exactly one, which.
+  struct Found {
+    float clearance = 0;
+    uint16_t count = 0, only = 0;
+  };
+
+  // Adds every collider's share of the density sums at p (as TankWalls::add does for the tank); `found` and,
+  // for a single collider, its gradient `onlyGradient` say what it found.
+  // A collider whose near box does not hold p is more than support + radius away, one that is not even a
+  // candidate further; a particle far from all (farFrom) is given the support alone, so that carry passes it by.
+  void add(const VecD& p, float& weight, VecD& gradient, Found& found, VecD& onlyGradient) const {
+    found = Found{support_, 0, 0};
+    if (farFrom(p)) return;
+    found.clearance = support_ + radius_;
+    forEachInReach(p, [&](size_t c, float d, const VecD& n) {
+      found.clearance = std::min(found.clearance, placed_[c].shape->distanceBoundsMoves() ? d : -INFINITY);
+      if (d >= support_) return;
       float w;
       VecD g;
       wallTerms(c, p, d, n, w, g);
       weight += w;
       gradient += g;
+      if (found.count++ == 0) {
+        found.only = static_cast<uint16_t>(c);
+        onlyGradient = g;
+      }
     });
   }
+  void add(const VecD& p, float& weight, VecD& gradient) const {
+    Found unused;
+    VecD unusedGradient;
+    add(p, weight, gradient, unused, unusedGradient);
+  }
+
+  // True if nothing stops a move from `from`, where add found `found`, to p: every point of the move stays a
+  // radius (and a hundredth, for rounding) from every collider, and so does the tank's clamp of p (which moves
+  // it no further from `from`, `from` being inside the clamp): project and its corner rounds would do nothing.
+  bool nothingStops(const Found& found, const VecD& from, const VecD& p) const {
+    const float room = found.clearance - 1.01f * radius_;
+    return room > 0 && (p - from).squaredNorm() < room * room;
+  }
+  // Carries `found` from `from` to p (a distance less the move is still a bound) for a particle that add left
+  // clear of the support: while it stays clear, add would find nothing at p (clearOfSupport), and need not run.
+  // Any other is marked unknown (no room), so that add runs for it again before anything reads it.
+  void carry(Found& found, const VecD& from, const VecD& p) const {
+    found.clearance = found.clearance > support_ ? found.clearance - (p - from).norm() : -INFINITY;
+  }
+  bool clearOfSupport(const Found& found) const { return found.clearance > support_ + 0.01f * radius_; }
 
   // Signed distance from p to collider c's solid in the world (negative inside) and the unit normal there.
   float distance(size_t c, const VecD& p, VecD& normal) const;
@@ -132,6 +184,7 @@ class Colliders {
   // pushed(c, delta) for each collider that moved p by delta; returns true if any did.
   template <typename Pushed>
   bool project(const VecD& from, VecD& p, bool fromStepStart, Pushed&& pushed) const {
+    if (moveFarFrom(from, p)) return false;
     bool moved = false;
     // A move shorter than kShortMove, and the pushes it may take, stay within the grid's margin of p's cell.
     const uint16_t *c = all_.data(), *end = all_.data() + all_.size();
@@ -210,28 +263,50 @@ class Colliders {
 
   bool sweep(size_t c, const VecD& from, const VecD& p, bool fromStepStart, VecD& delta) const;
 
+  // Calls visit(c, distance, normal) for every collider whose near box holds p, in the colliders' order.
+  template <typename Visit>
+  void forEachInReach(const VecD& p, Visit&& visit) const {
+    if (farFrom(p)) return;
+    const uint16_t *c = nullptr, *end = nullptr;
+    candidates(p, c, end);
+    for (; c != end; ++c) {
+      if (!placed_[*c].near.contains(p)) continue;
+      VecD normal;
+      const float d = distance(*c, p, normal);
+      visit(*c, d, normal);
+    }
+  }
+
   // The colliders whose near boxes, grown by the grid's margin, reach the grid cell of p (every collider for a
   // p off the grid), ascending: a particle tests those only, not all of them (ten floating bodies cost 17% of a
-  // step when every particle tested every one). Built by beginStep over the tank, cells at least twice the
-  // kernel support and at most 64 a side.
+  // step when every particle tested every one). Built by beginStep over the tank, cells at least the kernel
+  // support and at most 64 a side.
   void candidates(const VecD& p, const uint16_t*& begin, const uint16_t*& end) const {
-    Eigen::Array<int, Dim, 1> cell;
-    for (int k = 0; k < Dim; ++k) {
-      const float u = (p[k] - gridMin_[k]) * cellInverse_[k];
-      if (!(u >= 0 && u < gridCounts_[k])) {  // also NaN
-        begin = all_.data();
-        end = all_.data() + all_.size();
-        return;
-      }
-      cell[k] = static_cast<int>(u);
+    size_t index;
+    if (!cellOf(p, index)) {
+      begin = all_.data();
+      end = all_.data() + all_.size();
+      return;
     }
-    size_t index = cell[Dim - 1];
-    for (int k = Dim - 2; k >= 0; --k) index = index * gridCounts_[k] + cell[k];
     begin = cellSolids_.data() + cellStart_[index];
     end = cellSolids_.data() + cellStart_[index + 1];
   }
+  // The index of p's grid cell; false for a p off the grid (or NaN).
+  bool cellOf(const VecD& p, size_t& index) const {
+    Eigen::Array<int, Dim, 1> cell;
+    for (int k = 0; k < Dim; ++k) {
+      const float u = (p[k] - gridMin_[k]) * cellInverse_[k];
+      if (!(u >= 0 && u < gridCounts_[k])) return false;
+      cell[k] = static_cast<int>(u);
+    }
+    index = cell[Dim - 1];
+    for (int k = Dim - 2; k >= 0; --k) index = index * gridCounts_[k] + cell[k];
+    return true;
+  }
   void buildGrid();
   static constexpr float kShortMove = 4;  // in particle radii
+  static constexpr float kGridMargin = kShortMove + 2 * kShortMove + 2;  // see buildGrid
+  static constexpr float kFarMargin = 4, kFarReach = 2;  // in particle radii; see farFrom
 
   std::shared_ptr<const ColliderShapes> shapes_;
   std::vector<ColliderSettings> settings_;
@@ -240,6 +315,7 @@ class Colliders {
   float support_ = 0, radius_ = 0, dt_ = 1;
   bool hasFriction_ = false;
   std::vector<Wrench> slots_, extra_, stepMark_;
+  std::vector<uint8_t> cellReached_;  // 1 for a cell that some near box, grown by kFarMargin radii, reaches
   std::vector<uint16_t> all_, cellSolids_;
   std::vector<uint32_t> cellStart_;
   VecD gridMin_ = VecD::Zero(), cellInverse_ = VecD::Zero();

@@ -342,15 +342,6 @@ void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radi
       1);
 }
 
-template <typename T>
-void gatherByOrder(const std::vector<uint32_t>& order, std::vector<T>& values, std::vector<T>& scratch) {
-  scratch.resize(values.size());
-  parallelFor(0, values.size(), [&](size_t b, size_t e) {
-    for (size_t k = b; k < e; ++k) scratch[k] = values[order[k]];
-  });
-  values.swap(scratch);
-}
-
 template class NeighborGrid<2>;
 template class NeighborGrid<3>;
 template uint32_t* keepInRange<2>(const float*, size_t, const Vec<2>&, float, uint32_t, uint32_t, uint32_t, uint32_t*);
@@ -371,9 +362,5 @@ template uint32_t* keepInRangeAvx2<2>(const float*, size_t, const Vec<2>&, float
 template uint32_t* keepInRangeAvx2<3>(const float*, size_t, const Vec<3>&, float, uint32_t, uint32_t, uint32_t,
                                       uint32_t*);
 #endif
-template void gatherByOrder(const std::vector<uint32_t>&, std::vector<Vec<2>>&, std::vector<Vec<2>>&);
-template void gatherByOrder(const std::vector<uint32_t>&, std::vector<Vec<3>>&, std::vector<Vec<3>>&);
-template void gatherByOrder(const std::vector<uint32_t>&, std::vector<uint32_t>&, std::vector<uint32_t>&);
-template void gatherByOrder(const std::vector<uint32_t>&, std::vector<float>&, std::vector<float>&);
 
 }  // namespace surge

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/parallel.h"
 #include "sim/kernels.h"
 
 namespace surge {
@@ -139,7 +140,13 @@ uint32_t* keepInRangeAvx2(const float* coordinates, size_t n, const Vec<Dim>& xi
 
 // Applies a permutation: values[k] = old values[order[k]], in parallel. Used to reorder every particle channel.
 template <typename T>
-void gatherByOrder(const std::vector<uint32_t>& order, std::vector<T>& values, std::vector<T>& scratch);
+void gatherByOrder(const std::vector<uint32_t>& order, std::vector<T>& values, std::vector<T>& scratch) {
+  scratch.resize(values.size());
+  parallelFor(0, values.size(), [&](size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) scratch[k] = values[order[k]];
+  });
+  values.swap(scratch);
+}
 
 extern template class NeighborGrid<2>;
 extern template class NeighborGrid<3>;

@@ -81,6 +81,11 @@ void PbfSolver<Dim>::setParticles(const ParticleFrame& frame) {
   lambda_.assign(n, 0.0f);
   if (warmStart_ > 0) lambdaTotal_.assign(n, 0.0f);
   colliders_.resetSlots(n);
+  foundHolds_ = false;
+  if (!colliders_.empty()) {
+    found_.resize(n);
+    onlyGradient_.resize(n);
+  }
   if (vorticityEpsilon_ > 0) (Dim == 3 ? omega3_.resize(n) : omega2_.resize(n));
   speedLimit_ = runawaySpeedFor(sceneSpeedLimit_, v_);
 }
@@ -93,6 +98,7 @@ void PbfSolver<Dim>::getParticles(ParticleFrame& frame) const {
 template <int Dim>
 long PbfSolver<Dim>::step(float dt, double time) {
   stepDt_ = dt;
+  foundHolds_ = foundHolds_ && !colliders_.anyMoving();
   if (!colliders_.empty()) colliders_.beginStep(time, dt);
   predictPositions(dt, time);
   findNeighbors();
@@ -116,8 +122,16 @@ void PbfSolver<Dim>::predictPositions(float dt, double time) {
       v_[i] += dt * gravity_;
       if (attract) v_[i] += dt * attractor_.acceleration(x_[i], attractorAt);
       p_[i] = x_[i] + dt * v_[i];
-      if (!colliders_.empty()) collide(i, x_[i], true);
-      else walls_.clamp(p_[i]);
+      if (colliders_.empty()) {
+        walls_.clamp(p_[i]);
+        continue;
+      }
+      const bool found = foundHolds_;
+      if (colliders_.moveFarFrom(x_[i], p_[i]) || (found && colliders_.nothingStops(found_[i], x_[i], p_[i])))
+        walls_.clamp(p_[i]);
+      else
+        collide(i, x_[i], true);
+      if (found) colliders_.carry(found_[i], x_[i], p_[i]);
     }
   });
 }
@@ -167,6 +181,7 @@ void PbfSolver<Dim>::findNeighbors() {
   gatherByOrder(order, p_, scratch_);
   gatherByOrder(order, id_, scratchIds_);
   if (!lambdaTotal_.empty()) gatherByOrder(order, lambdaTotal_, scratchFloats_);
+  if (foundHolds_) gatherByOrder(order, found_, scratchFound_);
   grid_.findNeighbors(p_, kernels_.radius(), neighbors_);
   sizeForPairs(neighbors_, pairGradientFactors_);
   times_.neighbors += millisecondsSince(start);
@@ -213,8 +228,15 @@ void PbfSolver<Dim>::solveDensityConstraints() {
 template <int Dim>
 void PbfSolver<Dim>::applyWarmStart() {
   parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) lambda_[i] = lambdaTotal_[i] = warmStart_ * lambdaTotal_[i];
+    for (size_t i = b; i < e; ++i) {
+      lambda_[i] = lambdaTotal_[i] = warmStart_ * lambdaTotal_[i];
+      if (colliders_.empty()) continue;
+      float unusedWeight = 0;  // what the colliders give p_, for the correction (found_)
+      VecD unusedGradient = VecD::Zero();
+      colliders_.add(p_[i], unusedWeight, unusedGradient, found_[i], onlyGradient_[i]);
+    }
   });
+  foundHolds_ = !colliders_.empty();
   applyPositionCorrections<true>();
 }
 
@@ -231,7 +253,7 @@ void PbfSolver<Dim>::restoreCarriedState(const std::vector<float>& state) {
 template <int Dim>
 double PbfSolver<Dim>::computeLambdas(float omega) {
   const float selfWeight = kernels_.poly6(0.0f);
-  return parallelSum<double>(0, size(), [&](size_t b, size_t e) {
+  const double averageError = parallelSum<double>(0, size(), [&](size_t b, size_t e) {
     double errorSum = 0;
     for (size_t i = b; i < e; ++i) {
       const VecD pi = p_[i];
@@ -282,10 +304,11 @@ double PbfSolver<Dim>::computeLambdas(float omega) {
       VecD wallGradient = VecD::Zero();
       walls_.add(p_[i], weight, wallGradient);
       gradientI += massOverRho_ * wallGradient;
-      if (!colliders_.empty()) {
+      // A particle that stayed clear of the colliders' support since the last pass found it so gets nothing.
+      if (!colliders_.empty() && !(foundHolds_ && colliders_.clearOfSupport(found_[i]))) {
         float colliderWeight = 0;
         VecD colliderGradient = VecD::Zero();
-        colliders_.add(pi, colliderWeight, colliderGradient);
+        colliders_.add(pi, colliderWeight, colliderGradient, found_[i], onlyGradient_[i]);
         weight += colliderWeight;
         gradientI += massOverRho_ * colliderGradient;
       }
@@ -302,6 +325,8 @@ double PbfSolver<Dim>::computeLambdas(float omega) {
     }
     return errorSum;
   }) / std::max<double>(1, size());
+  foundHolds_ = !colliders_.empty();
+  return averageError;
 }
 
 // Eq. 12 with the artificial pressure of eq. 13-14:
@@ -384,32 +409,43 @@ void PbfSolver<Dim>::applyPositionCorrections() {
       delta += lambda_[i] * wallGradient;
       scratch_[i] = massOverRho_ * delta;
       // The colliders likewise; each one's share is an impulse it gives the particle.
-      if (!colliders_.empty() && lambdaI != 0.0f) scratch_[i] += colliderCorrection(i, pi, lambdaI);
+      if (!colliders_.empty() && lambdaI != 0.0f && found_[i].count > 0)
+        scratch_[i] += colliderCorrection(i, pi, lambdaI);
     }
   });
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const VecD before = p_[i];
       p_[i] += scratch_[i];
-      if (!colliders_.empty()) collide(i, before, false);
-      else walls_.clamp(p_[i]);
+      if (colliders_.empty()) {
+        walls_.clamp(p_[i]);
+        continue;
+      }
+      if (colliders_.nothingStops(found_[i], before, p_[i])) walls_.clamp(p_[i]);
+      else collide(i, before, false);
+      colliders_.carry(found_[i], before, p_[i]);
     }
   });
 }
 
 // The colliders' share of eq. 12 for particle i at p with lambda_i: (m / rho_0) lambda_i sum_c grad W_c, each
-// collider's part an impulse it gives the particle. Kept out of the loop above, which stays as it was for a
-// scene without colliders (same instructions, same bytes).
+// collider's part an impulse it gives the particle. The lambda pass found the colliders at p (found_); the
+// gradient of a single one, as most particles near any have, is kept from there. Kept out of the loop above,
+// which stays as it was for a scene without colliders (same instructions, same bytes).
 template <int Dim>
 typename PbfSolver<Dim>::VecD PbfSolver<Dim>::colliderCorrection(size_t i, const VecD& p, float lambda) {
+  auto share = [&](size_t c, const VecD& gradient) {
+    const VecD move = (massOverRho_ * lambda) * gradient;
+    colliders_.addImpulse(i, c, (mass_ / stepDt_) * move, p);
+    return move;
+  };
+  if (found_[i].count == 1) return share(found_[i].only, onlyGradient_[i]);
   VecD delta = VecD::Zero();
   colliders_.forEachNear(p, [&](size_t c, float d, const VecD& n) {
     float unused;
     VecD gradient;
     colliders_.wallTerms(c, p, d, n, unused, gradient);
-    const VecD move = (massOverRho_ * lambda) * gradient;
-    delta += move;
-    colliders_.addImpulse(i, c, (mass_ / stepDt_) * move, p);
+    delta += share(c, gradient);
   });
   return delta;
 }
@@ -531,6 +567,8 @@ size_t PbfSolver<Dim>::memoryBytes() const {
   bytes += (lambda_.capacity() + lambdaTotal_.capacity() + scratchFloats_.capacity() + omega2_.capacity()) *
            sizeof(float);
   for (const auto& factors : pairGradientFactors_) bytes += factors.capacity() * sizeof(float);
+  bytes += (found_.capacity() + scratchFound_.capacity()) * sizeof(typename Colliders<Dim>::Found) +
+           onlyGradient_.capacity() * sizeof(VecD);
   return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes();
 }
 

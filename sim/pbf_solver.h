@@ -131,6 +131,14 @@ class PbfSolver final : public FluidSolver<Dim> {
   float sceneSpeedLimit_ = 0;  // runawaySpeed(scene)
   float speedLimit_ = 0;       // and ten times the fastest particle given (runawaySpeedFor): faster is a blow-up
   Colliders<Dim> colliders_;  // empty without colliders
+  // What the colliders gave each particle at p_ in the lambda pass (or the warm start's), reused by the
+  // correction that follows at the same positions; sized only with colliders.
+  std::vector<typename Colliders<Dim>::Found> found_;
+  std::vector<VecD> onlyGradient_;
+  std::vector<typename Colliders<Dim>::Found> scratchFound_;
+  // found_ holds for the particles where they stand: taken at this step's positions and carried since, or at the
+  // last step's end when no collider moves.
+  bool foundHolds_ = false;
   float stepDt_ = 0;          // the current step (turns collider displacements into impulses)
   NeighborLists neighbors_;
   // Per neighbour pair, parallel to neighbors_: the spiky gradient factor g of Kernels::pair, computed by the

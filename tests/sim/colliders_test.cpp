@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "sim/particle_channels.h"
 #include "sim/pbf_solver.h"
@@ -170,6 +171,101 @@ TEST(Colliders, BoxCountsTheLatticeInsideItExactly) {
 // The thin plate: a box one spacing thick across the whole tank (through its walls) under a column of water
 // thrown down at 10 m/s. Nothing may pass, through the plate or where it meets the walls: every particle stays
 // above it, at least a radius minus a thousandth of a spacing (float rounding of the projection) from it.
+// What a particle skips, it would have found nothing in (Colliders::farFrom, Found, nothingStops, carry): at
+// points about every shape (a tilted box, a ball, a capsule, a cylinder, a box moving over the step), checked
+// against the distances themselves, sampled along each move:
+//  - a point its cell marks far lies two radii beyond the support, and a move that moveFarFrom passes stays
+//    beyond the support;
+//  - what add found bounds every collider's distance from below and counts those within the support;
+//  - a move that nothingStops passes keeps a radius from every collider;
+//  - a bound carried along moves, while clearOfSupport holds, leaves every collider beyond the support.
+// Each was seen failing: with no margin for the far cells, with carry not taking the move off, and with
+// nothingStops leaving out the radius.
+TEST(Colliders, WhatAParticleSkipsItWouldFindNothingIn) {
+  const Scene scene = makeScene(3, R"({"min": [0, 0, 0], "max": [1, 1, 1]})",
+                                R"([{"box": {"min": [0, 0, 0], "max": [0.1, 0.1, 0.1]}}])", R"([
+      {"shape": "box", "position": [0.3, 0.3, 0.3], "size": [0.2, 0.1, 0.15],
+       "rotation": {"axis": [1, 1, 0], "degrees": 30}},
+      {"shape": "sphere", "position": [0.7, 0.3, 0.3], "radius": 0.08},
+      {"shape": "capsule", "position": [0.3, 0.7, 0.7], "radius": 0.05, "height": 0.2,
+       "rotation": {"axis": [0, 0, 1], "degrees": 60}},
+      {"shape": "cylinder", "position": [0.7, 0.7, 0.7], "radius": 0.06, "height": 0.15},
+      {"shape": "box", "size": [0.05, 0.2, 0.2],
+       "motion": [{"time": 0, "position": [0.5, 0.5, 0.2]}, {"time": 1, "position": [0.5, 0.5, 0.8]}]}])",
+                                0.02);
+  PbfSolver<3> solver(scene);
+  Colliders<3>& colliders = solver.colliders();
+  colliders.beginStep(0.5, 1.0f / 60);  // the moving box sweeps 1 cm over this step
+  const float support = static_cast<float>(scene.solver.kernel_radius), radius = colliders.particleRadius();
+  auto leastDistance = [&](const Eigen::Vector3f& a, const Eigen::Vector3f& b) {  // over the move a -> b
+    float least = INFINITY;
+    for (int k = 0; k <= 16; ++k)
+      for (size_t c = 0; c < colliders.size(); ++c) {
+        Eigen::Vector3f n;
+        least = std::min(least, colliders.distance(c, a + (k / 16.0f) * (b - a), n));
+      }
+    return least;
+  };
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> unit(-1, 1);
+  auto offset = [&](float length) -> Eigen::Vector3f {
+    const float x = unit(random), y = unit(random), z = unit(random);
+    return length * Eigen::Vector3f(x, y, z);
+  };
+  const Eigen::Vector3f centres[] = {{0.3f, 0.3f, 0.3f}, {0.7f, 0.3f, 0.3f}, {0.3f, 0.7f, 0.7f}, {0.7f, 0.7f, 0.7f},
+                                     {0.5f, 0.5f, 0.5f}};
+  int farPoints = 0, far = 0, near = 0, unstopped = 0, carried = 0;
+  for (int sample = 0; sample < 40000; ++sample) {
+    const Eigen::Vector3f p = centres[sample % 5] + offset(0.25f);
+    const Eigen::Vector3f q = p + offset(sample % 2 ? 3 * radius : 0.3f * radius);
+    // A far point is far enough that any move to it that moveFarFrom passes (under two radii) stays beyond the
+    // support.
+    if (colliders.farFrom(p)) {
+      ++farPoints;
+      ASSERT_GE(leastDistance(p, p), support + 2 * radius) << "far point " << p.transpose();
+    }
+    if (colliders.moveFarFrom(p, q)) {
+      ++far;
+      ASSERT_GE(leastDistance(p, q), support) << "far move " << p.transpose() << " -> " << q.transpose();
+    }
+    float weight = 0;
+    Eigen::Vector3f gradient = Eigen::Vector3f::Zero(), onlyGradient;
+    Colliders<3>::Found found;
+    colliders.add(p, weight, gradient, found, onlyGradient);
+    int within = 0;
+    for (size_t c = 0; c < colliders.size(); ++c) {
+      Eigen::Vector3f n;
+      const float d = colliders.distance(c, p, n);
+      ASSERT_GE(d, found.clearance) << "collider " << c << " at " << p.transpose();
+      within += d < support;
+    }
+    ASSERT_EQ(found.count, within) << p.transpose();
+    near += within > 0;
+    if (colliders.nothingStops(found, p, q)) {
+      ++unstopped;
+      ASSERT_GE(leastDistance(p, q), radius) << "unstopped move " << p.transpose() << " -> " << q.transpose();
+    }
+    // Carried along a walk of small moves while it says the particle stays clear of the support.
+    Eigen::Vector3f at = p;
+    for (int step = 0; step < 8 && colliders.clearOfSupport(found); ++step) {
+      const Eigen::Vector3f next = at + offset(0.5f * radius);
+      colliders.carry(found, at, next);
+      at = next;
+      if (!colliders.clearOfSupport(found)) break;
+      ++carried;
+      ASSERT_GE(leastDistance(at, at), support) << "carried to " << at.transpose();
+    }
+  }
+  // Every kind of skip was exercised, and points near the colliders too.
+  EXPECT_GT(farPoints, 1000);
+  EXPECT_GT(far, 1000);
+  EXPECT_GT(near, 1000);
+  EXPECT_GT(unstopped, 1000);
+  EXPECT_GT(carried, 1000);
+  std::printf("far points %d, far moves %d, near points %d, unstopped moves %d, carried steps %d of 40000 samples\n",
+              farPoints, far, near, unstopped, carried);
+}
+
 TEST(Colliders, ThinPlateHoldsAFastColumn) {
   const Scene scene = makeScene(3, R"({"min": [0, 0, 0], "max": [0.3, 0.8, 0.3]})",
                                 R"([{"box": {"min": [0, 0.45, 0], "max": [0.3, 0.75, 0.3]}, "velocity": [0, -10, 0]}])",
