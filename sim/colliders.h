@@ -81,9 +81,15 @@ class Colliders {
   // the colliders' order.
   template <typename Visit>
   void forEachNear(const VecD& p, Visit&& visit) const {
-    forEachInReach(p, [&](size_t c, float d, const VecD& n) {
-      if (d < support_) visit(c, d, n);
-    });
+    if (farFrom(p)) return;
+    const uint16_t *c = nullptr, *end = nullptr;
+    candidates(p, c, end);
+    for (; c != end; ++c) {
+      if (!placed_[*c].near.contains(p)) continue;
+      VecD normal;
+      const float d = distance(*c, p, normal);
+      if (d < support_) visit(*c, d, normal);
+    }
   }
 
   // True if no collider's near box comes within kFarMargin radii of p's grid cell: forEachNear(p) then finds
@@ -135,24 +141,33 @@ class Colliders {
   // Adds every collider's share of the density sums at p (as TankWalls::add does for the tank); `found` and,
   // for a single collider, its gradient `onlyGradient` say what it found.
   // A collider whose near box does not hold p is more than support + radius away, one that is not even a
-  // candidate further; a particle far from all (farFrom) is given the support alone, so that carry passes it by.
+  // candidate more than the grid's margin further; a particle far from all (farFrom) is given the support alone,
+  // so that carry passes it by.
   void add(const VecD& p, float& weight, VecD& gradient, Found& found, VecD& onlyGradient) const {
     found = Found{support_, 0, 0};
     if (farFrom(p)) return;
-    found.clearance = support_ + radius_;
-    forEachInReach(p, [&](size_t c, float d, const VecD& n) {
-      found.clearance = std::min(found.clearance, placed_[c].shape->distanceBoundsMoves() ? d : -INFINITY);
-      if (d >= support_) return;
+    found.clearance = support_ + radius_ + kGridMargin * radius_;
+    const uint16_t *c = nullptr, *end = nullptr;
+    candidates(p, c, end);
+    for (; c != end; ++c) {
+      if (!placed_[*c].near.contains(p)) {
+        found.clearance = std::min(found.clearance, support_ + radius_);
+        continue;
+      }
+      VecD n;
+      const float d = distance(*c, p, n);
+      found.clearance = std::min(found.clearance, placed_[*c].shape->distanceBoundsMoves() ? d : -INFINITY);
+      if (d >= support_) continue;
       float w;
       VecD g;
-      wallTerms(c, p, d, n, w, g);
+      wallTerms(*c, p, d, n, w, g);
       weight += w;
       gradient += g;
       if (found.count++ == 0) {
-        found.only = static_cast<uint16_t>(c);
+        found.only = *c;
         onlyGradient = g;
       }
-    });
+    }
   }
   void add(const VecD& p, float& weight, VecD& gradient) const {
     Found unused;
@@ -263,19 +278,6 @@ class Colliders {
 
   bool sweep(size_t c, const VecD& from, const VecD& p, bool fromStepStart, VecD& delta) const;
 
-  // Calls visit(c, distance, normal) for every collider whose near box holds p, in the colliders' order.
-  template <typename Visit>
-  void forEachInReach(const VecD& p, Visit&& visit) const {
-    if (farFrom(p)) return;
-    const uint16_t *c = nullptr, *end = nullptr;
-    candidates(p, c, end);
-    for (; c != end; ++c) {
-      if (!placed_[*c].near.contains(p)) continue;
-      VecD normal;
-      const float d = distance(*c, p, normal);
-      visit(*c, d, normal);
-    }
-  }
 
   // The colliders whose near boxes, grown by the grid's margin, reach the grid cell of p (every collider for a
   // p off the grid), ascending: a particle tests those only, not all of them (ten floating bodies cost 17% of a
