@@ -131,8 +131,8 @@ class Colliders {
   }
 
   // What add found at p, for a solver that reuses it at the same p (PBF's correction after its lambda pass): a
-  // lower bound on p's distance to every collider (the support when none is nearer; -infinity near a shape
-  // whose distance is an estimate), how many lie within the support, and for exactly one, which.
+  // lower bound on p's distance to every collider (-infinity near a shape whose distance is an estimate), how
+  // many lie within the support, and for exactly one, which.
   struct Found {
     float clearance = 0;
     uint16_t count = 0, only = 0;
@@ -277,7 +277,6 @@ class Colliders {
   void placeBox(Placed& k) const;
 
   bool sweep(size_t c, const VecD& from, const VecD& p, bool fromStepStart, VecD& delta) const;
-
 
   // The colliders whose near boxes, grown by the grid's margin, reach the grid cell of p (every collider for a
   // p off the grid), ascending: a particle tests those only, not all of them (ten floating bodies cost 17% of a
