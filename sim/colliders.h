@@ -81,15 +81,12 @@ class Colliders {
   // the colliders' order.
   template <typename Visit>
   void forEachNear(const VecD& p, Visit&& visit) const {
-    if (farFrom(p)) return;
-    const uint16_t *c = nullptr, *end = nullptr;
-    candidates(p, c, end);
-    for (; c != end; ++c) {
-      if (!placed_[*c].near.contains(p)) continue;
-      VecD normal;
-      const float d = distance(*c, p, normal);
-      if (d < support_) visit(*c, d, normal);
-    }
+    forEachCandidate(
+        p,
+        [&](size_t c, float d, const VecD& n) {
+          if (d < support_) visit(c, d, n);
+        },
+        [] {});
   }
 
   // True if no collider's near box comes within kFarMargin radii of p's grid cell: forEachNear(p) then finds
@@ -144,30 +141,24 @@ class Colliders {
   // candidate more than the grid's margin further; a particle far from all (farFrom) is given the support alone,
   // so that carry passes it by.
   void add(const VecD& p, float& weight, VecD& gradient, Found& found, VecD& onlyGradient) const {
-    found = Found{support_, 0, 0};
-    if (farFrom(p)) return;
-    found.clearance = support_ + radius_ + kGridMargin * radius_;
-    const uint16_t *c = nullptr, *end = nullptr;
-    candidates(p, c, end);
-    for (; c != end; ++c) {
-      if (!placed_[*c].near.contains(p)) {
-        found.clearance = std::min(found.clearance, support_ + radius_);
-        continue;
-      }
-      VecD n;
-      const float d = distance(*c, p, n);
-      found.clearance = std::min(found.clearance, placed_[*c].shape->distanceBoundsMoves() ? d : -INFINITY);
-      if (d >= support_) continue;
-      float w;
-      VecD g;
-      wallTerms(*c, p, d, n, w, g);
-      weight += w;
-      gradient += g;
-      if (found.count++ == 0) {
-        found.only = *c;
-        onlyGradient = g;
-      }
-    }
+    found = Found{support_ + radius_ + kGridMargin * radius_, 0, 0};
+    const bool near = forEachCandidate(
+        p,
+        [&](size_t c, float d, const VecD& n) {
+          found.clearance = std::min(found.clearance, placed_[c].shape->distanceBoundsMoves() ? d : -INFINITY);
+          if (d >= support_) return;
+          float w;
+          VecD g;
+          wallTerms(c, p, d, n, w, g);
+          weight += w;
+          gradient += g;
+          if (found.count++ == 0) {
+            found.only = static_cast<uint16_t>(c);
+            onlyGradient = g;
+          }
+        },
+        [&] { found.clearance = std::min(found.clearance, support_ + radius_); });
+    if (!near) found.clearance = support_;
   }
   void add(const VecD& p, float& weight, VecD& gradient) const {
     Found unused;
@@ -277,6 +268,25 @@ class Colliders {
   void placeBox(Placed& k) const;
 
   bool sweep(size_t c, const VecD& from, const VecD& p, bool fromStepStart, VecD& delta) const;
+
+  // Calls reach(c, distance, normal) for every candidate collider whose near box holds p and missed() for every
+  // other candidate, in the colliders' order; returns false, calling nothing, for a p far from all (farFrom).
+  template <typename Reach, typename Missed>
+  bool forEachCandidate(const VecD& p, Reach&& reach, Missed&& missed) const {
+    if (farFrom(p)) return false;
+    const uint16_t *c = nullptr, *end = nullptr;
+    candidates(p, c, end);
+    for (; c != end; ++c) {
+      if (!placed_[*c].near.contains(p)) {
+        missed();
+        continue;
+      }
+      VecD normal;
+      const float d = distance(*c, p, normal);
+      reach(*c, d, normal);
+    }
+    return true;
+  }
 
   // The colliders whose near boxes, grown by the grid's margin, reach the grid cell of p (every collider for a
   // p off the grid), ascending: a particle tests those only, not all of them (ten floating bodies cost 17% of a
