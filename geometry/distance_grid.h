@@ -1,11 +1,14 @@
 // A signed distance sampled on a dense grid (a mesh's, baked by geometry/mesh_sdf.cpp), read back by trilinear
 // interpolation with the interpolant's own gradient. Outside the grid the distance grows with the distance to the
 // grid's box, so a far point is far; the grid is made to cover its shape plus the band the simulator reads.
+// (Stored in bricks of 4^3 samples, so that a cell's corners share two cache lines, the torus benchmark of
+// docs/performance.md was no faster: its reads wait on the first line, not on the other three.)
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace surge {
@@ -13,15 +16,10 @@ namespace surge {
 class DistanceGrid {
  public:
   DistanceGrid() = default;
-  // Samples at origin + voxel * (i, j, k), i < counts[0] ..., x fastest.
-  DistanceGrid(const Eigen::Vector3f& origin, float voxel, const Eigen::Array3i& counts)
-      : origin_(origin), voxel_(voxel), counts_(counts) {
-    values_.assign(size_t(counts[0]) * counts[1] * counts[2], 0.0f);
-  }
+  // `samples` at origin + voxel * (i, j, k), i < counts[0] ..., x fastest (counts.prod() of them, each count >= 2).
+  DistanceGrid(const Eigen::Vector3f& origin, float voxel, const Eigen::Array3i& counts, std::vector<float> samples)
+      : origin_(origin), voxel_(voxel), counts_(counts), values_(std::move(samples)) {}
 
-  float& at(int i, int j, int k) { return values_[index(i, j, k)]; }
-  float at(int i, int j, int k) const { return values_[index(i, j, k)]; }
-  float* data() { return values_.data(); }
   const Eigen::Array3i& counts() const { return counts_; }
   const Eigen::Vector3f& origin() const { return origin_; }
   float voxel() const { return voxel_; }

@@ -40,16 +40,13 @@ DistanceGrid bakeMeshDistance(const TriangleMesh& mesh, float voxel, float band,
     hi[a] = int(std::ceil((box.max()[a] + reach) / voxel)) + 1;
   }
   const Eigen::Array3i counts(hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1);
-  DistanceGrid result(Eigen::Vector3f(lo[0], lo[1], lo[2]) * voxel, voxel, counts);
-  openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(openvdb::CoordBBox(lo, hi), result.data());
+  std::vector<float> samples(size_t(counts.prod()));
+  openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(openvdb::CoordBBox(lo, hi), samples.data());
   openvdb::tools::copyToDense(*grid, dense);
   // Voxels of the open mesh's unsigned field are in world units (grid values); the shell is half its thickness.
-  if (shellThickness > 0) {
-    float* values = result.data();
-    const size_t n = size_t(counts.prod());
-    for (size_t i = 0; i < n; ++i) values[i] -= 0.5f * shellThickness;
-  }
-  return result;
+  if (shellThickness > 0)
+    for (float& value : samples) value -= 0.5f * shellThickness;
+  return DistanceGrid(Eigen::Vector3f(lo[0], lo[1], lo[2]) * voxel, voxel, counts, std::move(samples));
 }
 
 }  // namespace surge

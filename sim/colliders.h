@@ -173,12 +173,11 @@ class Colliders {
     const float room = found.clearance - 1.01f * radius_;
     return room > 0 && (p - from).squaredNorm() < room * room;
   }
-  // Carries `found` from `from` to p (a distance less the move is still a bound) for a particle that add left
-  // clear of the support: while it stays clear, add would find nothing at p (clearOfSupport), and need not run.
-  // Any other is marked unknown (no room), so that add runs for it again before anything reads it.
-  void carry(Found& found, const VecD& from, const VecD& p) const {
-    found.clearance = found.clearance > support_ ? found.clearance - (p - from).norm() : -INFINITY;
-  }
+  // Carries `found` from `from` to p: a distance less the move is still a bound. While it keeps a particle clear
+  // of the support, add would find nothing at p (clearOfSupport) and need not run; while it leaves room, the
+  // next move need not be swept (nothingStops). Its count and gradient are those at `from`: a solver reads them
+  // only where add has just run.
+  void carry(Found& found, const VecD& from, const VecD& p) const { found.clearance -= (p - from).norm(); }
   bool clearOfSupport(const Found& found) const { return found.clearance > support_ + 0.01f * radius_; }
 
   // Signed distance from p to collider c's solid in the world (negative inside) and the unit normal there.

@@ -139,6 +139,75 @@ TriangleMesh icosphere(int levels) {
   return mesh;
 }
 
+// A distance grid (geometry/distance_grid.h) interpolates the samples it was given: at random points across a
+// grid of unequal counts, at its samples and at its far faces, the sample and its gradient match trilinear
+// interpolation of those values in double precision, to float rounding of values about 1 (1e-5). Outside, the
+// distance grows by the distance to the box. A read one sample off along any axis misses by the values' spread
+// (they are random in [-1, 1]); seen failing that way (0.45 off).
+TEST(ColliderShape, DistanceGridInterpolatesItsSamples) {
+  const Eigen::Array3i counts(8, 5, 11);
+  const Vec3 origin(-0.3f, 0.1f, 0.2f);
+  const float voxel = 0.05f;
+  std::mt19937 random(3);
+  std::uniform_real_distribution<float> unit(-1, 1);
+  std::vector<float> values(size_t(counts.prod()));
+  for (float& v : values) v = unit(random);
+  const DistanceGrid grid(origin, voxel, counts, values);
+  auto at = [&](int i, int j, int k) { return double(values[(size_t(k) * counts[1] + j) * counts[0] + i]); };
+  auto reference = [&](const Vec3& p, Eigen::Vector3d& gradient) {
+    // The point in voxels as the grid finds it (in float, kept a ten-thousandth of a voxel inside the far faces);
+    // the interpolation from there in double.
+    const Vec3 u = (p - origin) / voxel;
+    int cell[3];
+    double f[3];
+    for (int a = 0; a < 3; ++a) {
+      const float inside = std::min(std::max(u[a], 0.0f), float(counts[a] - 1) - 1e-4f);
+      cell[a] = int(inside);
+      f[a] = double(inside) - cell[a];
+    }
+    double value = 0;
+    gradient.setZero();
+    for (int corner = 0; corner < 8; ++corner) {
+      const int o[3] = {corner & 1, (corner >> 1) & 1, (corner >> 2) & 1};
+      double w[3], dw[3];
+      for (int a = 0; a < 3; ++a) {
+        w[a] = o[a] ? f[a] : 1 - f[a];
+        dw[a] = o[a] ? 1 : -1;
+      }
+      const double c = at(cell[0] + o[0], cell[1] + o[1], cell[2] + o[2]);
+      value += w[0] * w[1] * w[2] * c;
+      gradient += Eigen::Vector3d(dw[0] * w[1] * w[2], w[0] * dw[1] * w[2], w[0] * w[1] * dw[2]) * c / voxel;
+    }
+    return value;
+  };
+  std::vector<Vec3> points;
+  for (int n = 0; n < 4000; ++n) {
+    const Vec3 u(0.5f * (unit(random) + 1) * (counts[0] - 1), 0.5f * (unit(random) + 1) * (counts[1] - 1),
+                 0.5f * (unit(random) + 1) * (counts[2] - 1));
+    points.push_back(origin + voxel * u);
+  }
+  for (int k = 0; k < counts[2]; ++k)
+    for (int j = 0; j < counts[1]; ++j)
+      for (int i = 0; i < counts[0]; ++i) points.push_back(origin + voxel * Vec3(float(i), float(j), float(k)));
+  for (const Vec3& p : points) {
+    Vec3 gradient;
+    Eigen::Vector3d expectedGradient;
+    const float value = grid.sample(p, gradient);
+    ASSERT_NEAR(value, reference(p, expectedGradient), 1e-5) << p.transpose();
+    // At a sample on a cell's face the gradient is one-sided; the row-major grid took the same side.
+    const Vec3 u = (p - origin) / voxel;
+    if ((u.array() - u.array().round()).abs().minCoeff() < 1e-3f) continue;
+    ASSERT_LT((gradient.cast<double>() - expectedGradient).norm(), 1e-5 / voxel) << p.transpose();
+  }
+  // Outside the box: the value at the nearest point of the box, plus the distance to it.
+  const Vec3 corner = origin + voxel * Vec3(float(counts[0] - 1), float(counts[1] - 1), float(counts[2] - 1));
+  Vec3 gradient;
+  Eigen::Vector3d unused;
+  const Vec3 beyond = corner + Vec3(0.03f, 0.04f, 0.0f);
+  EXPECT_NEAR(grid.sample(beyond, gradient), reference(corner, unused) + 0.05, 1e-5);
+  EXPECT_NEAR(gradient.dot(Vec3(0.6f, 0.8f, 0.0f)), 1.0f, 1e-5f);
+}
+
 // The mesh's baked distance against the sphere it approximates. An icosphere of 4 levels (5120 triangles) lies
 // within 1 - cos(pi / 5 / 16)^-ish ~ 0.1% of the radius of the true sphere; trilinear interpolation of a distance
 // on a grid of voxel v errs by at most ~ v^2 / (8 R) for a sphere (its curvature), far below the voxel. So the

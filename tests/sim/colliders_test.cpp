@@ -178,9 +178,10 @@ TEST(Colliders, BoxCountsTheLatticeInsideItExactly) {
 //    beyond the support;
 //  - what add found bounds every collider's distance from below and counts those within the support;
 //  - a move that nothingStops passes keeps a radius from every collider;
-//  - a bound carried along moves, while clearOfSupport holds, leaves every collider beyond the support.
-// Each was seen failing: with no margin for the far cells, with carry not taking the move off, and with
-// nothingStops leaving out the radius.
+//  - a bound carried along moves leaves every collider beyond the support where clearOfSupport holds, and a
+//    radius from every point of a move that nothingStops passes on it.
+// Each was seen failing: with no margin for the far cells, with carry not taking the move off (of a bound clear
+// of the support, and of one within it), and with nothingStops leaving out the radius.
 TEST(Colliders, WhatAParticleSkipsItWouldFindNothingIn) {
   const Scene scene = makeScene(3, R"({"min": [0, 0, 0], "max": [1, 1, 1]})",
                                 R"([{"box": {"min": [0, 0, 0], "max": [0.1, 0.1, 0.1]}}])", R"([
@@ -214,7 +215,7 @@ TEST(Colliders, WhatAParticleSkipsItWouldFindNothingIn) {
   };
   const Eigen::Vector3f centres[] = {{0.3f, 0.3f, 0.3f}, {0.7f, 0.3f, 0.3f}, {0.3f, 0.7f, 0.7f}, {0.7f, 0.7f, 0.7f},
                                      {0.5f, 0.5f, 0.5f}};
-  int farPoints = 0, far = 0, near = 0, unstopped = 0, carried = 0;
+  int farPoints = 0, far = 0, near = 0, unstopped = 0, carried = 0, carriedUnstopped = 0;
   for (int sample = 0; sample < 40000; ++sample) {
     const Eigen::Vector3f p = centres[sample % 5] + offset(0.25f);
     const Eigen::Vector3f q = p + offset(sample % 2 ? 3 * radius : 0.3f * radius);
@@ -245,13 +246,18 @@ TEST(Colliders, WhatAParticleSkipsItWouldFindNothingIn) {
       ++unstopped;
       ASSERT_GE(leastDistance(p, q), radius) << "unstopped move " << p.transpose() << " -> " << q.transpose();
     }
-    // Carried along a walk of small moves while it says the particle stays clear of the support.
+    // Carried along a walk of small moves: where it says the particle is clear of the support, it is, and a
+    // move that it lets pass unswept keeps a radius from every collider.
     Eigen::Vector3f at = p;
-    for (int step = 0; step < 8 && colliders.clearOfSupport(found); ++step) {
+    for (int step = 0; step < 8; ++step) {
       const Eigen::Vector3f next = at + offset(0.5f * radius);
+      if (colliders.nothingStops(found, at, next)) {
+        ++carriedUnstopped;
+        ASSERT_GE(leastDistance(at, next), radius) << "carried, unstopped " << at.transpose();
+      }
       colliders.carry(found, at, next);
       at = next;
-      if (!colliders.clearOfSupport(found)) break;
+      if (!colliders.clearOfSupport(found)) continue;
       ++carried;
       ASSERT_GE(leastDistance(at, at), support) << "carried to " << at.transpose();
     }
@@ -262,8 +268,10 @@ TEST(Colliders, WhatAParticleSkipsItWouldFindNothingIn) {
   EXPECT_GT(near, 1000);
   EXPECT_GT(unstopped, 1000);
   EXPECT_GT(carried, 1000);
-  std::printf("far points %d, far moves %d, near points %d, unstopped moves %d, carried steps %d of 40000 samples\n",
-              farPoints, far, near, unstopped, carried);
+  EXPECT_GT(carriedUnstopped, 1000);
+  std::printf("far points %d, far moves %d, near points %d, unstopped moves %d, carried steps %d (clear) and %d "
+              "(unstopped) of 40000 samples\n",
+              farPoints, far, near, unstopped, carried, carriedUnstopped);
 }
 
 TEST(Colliders, ThinPlateHoldsAFastColumn) {
