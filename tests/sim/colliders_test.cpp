@@ -388,7 +388,27 @@ INSTANTIATE_TEST_SUITE_P(
                       RestCase{"slope", R"({"shape": "box", "position": [0.3, 0.0], "size": [0.6, 0.2],
                                             "rotation": {"degrees": 20}})"},
                       RestCase{"capsule", R"({"shape": "capsule", "position": [0.6, 0.15], "radius": 0.06,
-                                              "height": 0.2, "rotation": {"degrees": 60}})"}),
+                                              "height": 0.2, "rotation": {"degrees": 60}})"},
+                      // A cylinder along its y axis is a rectangle in the plane: here 0.12 x 0.2, tilted, its
+                      // lowest corner 1.7 spacings above the floor. (Within a spacing of the floor, a particle
+                      // caught under it ends 0.89 radii from it: docs/colliders.md, "Corners".)
+                      RestCase{"cylinder", R"({"shape": "cylinder", "position": [0.45, 0.15], "radius": 0.06,
+                                               "height": 0.2, "rotation": {"degrees": 30}})"},
+                      // The shipped boulder (closed OBJ, baked by OpenVDB), 0.3 m across, its section at z = 0;
+                      // its flat bottom 2.2 spacings above the floor (0.65 spacings: 0.87 radii, as above).
+                      RestCase{"mesh", R"({"shape": "mesh", "file": ")" + std::string(SURGE_SOURCE_DIR) +
+                                           R"(/scenes/assets/rock.obj", "position": [0.5, 0.13], "scale": 0.3})"},
+                      // The shipped terrain (16-bit PNG) across the pool: its profile along the middle of z, a
+                      // slope from 0.12 m down to a basin, crossing the winding channel's banks.
+                      RestCase{"heightfield", R"({"shape": "heightfield", "file": ")" +
+                                                  std::string(SURGE_SOURCE_DIR) +
+                                                  R"(/scenes/assets/terrain.png", "position": [0.5, 0.0],
+                                                  "size": [1.0, 0.5], "height": 0.15})"},
+                      // A tilted box holding the water inside the tank: walls standing in the pool 10 cm in from
+                      // the tank's, its floor 8 cm or more below the tank's. (0.9 m wide, its floor came within
+                      // 1 cm of the tank's, and the band took a sliver of the floor's layers: 1.075.)
+                      RestCase{"container", R"({"shape": "box", "container": 1, "position": [0.5, 0.35],
+                                                "size": [0.8, 0.8], "rotation": {"degrees": 5}})"}),
     [](const ::testing::TestParamInfo<RestCase>& info) { return info.param.name; });
 
 }  // namespace
