@@ -39,6 +39,55 @@ std::string rangeText(const FieldInfo& info) {
   return text;
 }
 
+// JSON has no NaN or infinity, but Python's json module (and JavaScript's) writes them as the bare words NaN,
+// Infinity and -Infinity, so scenes written by scripts hold them. A scene that does not parse is read again with
+// each such word (outside strings) turned into a marked string, so that the reader names the key that holds it
+// rather than a byte.
+const char kNonFiniteMark = '\x01';
+
+constexpr const char* kNonFiniteWords[] = {"NaN", "Infinity", "-Infinity"};
+
+std::string markNonFiniteWords(const std::string& text) {
+  auto wordChar = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.'; };
+  // The word that stands whole at i, or nullptr.
+  auto wordAt = [&](size_t i) -> const char* {
+    if (i > 0 && wordChar(text[i - 1])) return nullptr;
+    for (const char* word : kNonFiniteWords) {
+      const size_t n = std::char_traits<char>::length(word);
+      if (text.compare(i, n, word) == 0 && !(i + n < text.size() && wordChar(text[i + n]))) return word;
+    }
+    return nullptr;
+  };
+  std::string marked;
+  marked.reserve(text.size());
+  bool inString = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (inString) {
+      marked += c;
+      if (c == '\\' && i + 1 < text.size()) marked += text[++i];
+      else if (c == '"') inString = false;
+    } else if (const char* word = wordAt(i)) {
+      marked += std::string("\"\\u0001") + word + "\"";
+      i += std::char_traits<char>::length(word) - 1;
+    } else {
+      marked += c;
+      inString = c == '"';
+    }
+  }
+  return marked;
+}
+
+// The word a marked string stands for (markNonFiniteWords), or nullptr for any other value.
+const char* nonFiniteWord(const json& value) {
+  if (!value.is_string()) return nullptr;
+  const std::string& s = value.get_ref<const std::string&>();
+  if (s.empty() || s[0] != kNonFiniteMark) return nullptr;
+  for (const char* word : kNonFiniteWords)
+    if (s.compare(1, std::string::npos, word) == 0) return word;
+  return nullptr;
+}
+
 // Reads JSON into the scene, checking types, ranges, required and unknown keys.
 class JsonReader : public SceneVisitor {
  public:
@@ -52,6 +101,7 @@ class JsonReader : public SceneVisitor {
 
   void text(const char* key, std::string& value, const FieldInfo& info) override {
     if (const json* j = find(key, info)) {
+      failIfNonFinite(key, *j);
       if (!j->is_string()) fail(key, "expected a string, got " + describe(*j));
       value = j->get<std::string>();
       if (info.required && value.empty()) fail(key, "must not be empty");
@@ -67,6 +117,7 @@ class JsonReader : public SceneVisitor {
   void choice(const char* key, std::string& value, const std::vector<std::string>& options,
               const FieldInfo& info) override {
     if (const json* j = find(key, info)) {
+      failIfNonFinite(key, *j);
       if (!j->is_string()) fail(key, "expected a string, got " + describe(*j));
       value = j->get<std::string>();
       for (const std::string& option : options)
@@ -79,6 +130,7 @@ class JsonReader : public SceneVisitor {
 
   void integer(const char* key, int& value, const FieldInfo& info) override {
     if (const json* j = find(key, info)) {
+      failIfNonFinite(key, *j);
       if (!j->is_number_integer()) fail(key, "expected an integer, got " + describe(*j));
       const long long v = j->get<long long>();
       checkRange(key, double(v), info);
@@ -88,6 +140,7 @@ class JsonReader : public SceneVisitor {
 
   void real(const char* key, double& value, const FieldInfo& info) override {
     if (const json* j = find(key, info)) {
+      failIfNonFinite(key, *j);
       if (!j->is_number()) fail(key, "expected a number, got " + describe(*j));
       const double v = j->get<double>();
       checkRange(key, v, info);
@@ -102,6 +155,7 @@ class JsonReader : public SceneVisitor {
         fail(key, "expected an array of " + std::to_string(n) + " numbers, got " + describe(*j));
       Eigen::Vector3d v = Eigen::Vector3d::Zero();
       for (size_t k = 0; k < n; ++k) {
+        failIfNonFinite(key, (*j)[k]);
         if (!(*j)[k].is_number()) fail(key, "expected numbers, got " + describe(*j));
         v[k] = (*j)[k].get<double>();
         if (!std::isfinite(v[k])) fail(key, "must be finite");
@@ -117,6 +171,7 @@ class JsonReader : public SceneVisitor {
         fail(key, "expected an array of 1 to 3 numbers, got " + describe(*j));
       values.clear();
       for (const json& item : *j) {
+        failIfNonFinite(key, item);
         if (!item.is_number()) fail(key, "expected numbers, got " + describe(*j));
         values.push_back(item.get<double>());
         checkRange(key, values.back(), info);
@@ -168,6 +223,9 @@ class JsonReader : public SceneVisitor {
   }
 
   [[noreturn]] void fail(const char* key, const std::string& message) const { throw error(path(key), message); }
+  void failIfNonFinite(const char* key, const json& value) const {
+    if (const char* word = nonFiniteWord(value)) fail(key, std::string("is ") + word + "; numbers must be finite");
+  }
 
   const json* find(const char* key, const FieldInfo& info) {
     Level& level = stack_.back();
@@ -539,6 +597,10 @@ size_t bytesPerParticleEstimate(int dimensions, const std::string& method) {
 
 Scene parseScene(const std::string& text, const std::string& where, const std::vector<std::string>& overrides) {
   json root = json::parse(text, nullptr, false);
+  if (root.is_discarded()) {
+    const std::string marked = markNonFiniteWords(text);
+    if (marked != text) root = json::parse(marked, nullptr, false);
+  }
   if (root.is_discarded()) {
     // Re-parse with exceptions to learn where the syntax error is.
     try {

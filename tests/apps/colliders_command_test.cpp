@@ -84,6 +84,10 @@ TEST(CollidersCommand, BadInputIsOneLineAndWritesNothing) {
       {R"({"shape": "sphere", "position": [5, 5, 5]})", "colliders[0]"},
       {R"({"shape": "sphere", "rotation": {"axis": [0, 0, 0], "degrees": 5}})", "colliders[0].rotation.axis"},
       {R"({"shape": "box", "size": [0.1, 0.1]})", "colliders[0].size"},
+      // NaN as Python's json module writes it (JSON itself has none).
+      {R"({"shape": "sphere", "position": [0.3, NaN, 0.1], "radius": 0.05})", "colliders[0].position"},
+      {R"({"shape": "sphere", "rotation": {"axis": [0, 1, 0], "degrees": NaN}})", "colliders[0].rotation.degrees"},
+      {R"({"shape": "sphere", "scale": Infinity})", "colliders[0].scale"},
   };
   for (const Case& c : cases) {
     std::string text = kObstacles;

@@ -142,6 +142,38 @@ TEST(Scene, EveryBadInputIsOneLineNamingFileAndKey) {
             std::string::npos);
 }
 
+// NaN, Infinity and -Infinity, as Python's json module writes them (JSON has neither), are named by their key,
+// wherever they stand: a vector's element, a number, an integer, a string's place; inside a string they are text.
+TEST(Scene, NonFiniteWordsAreNamedByTheirKey) {
+  // kValid with each (from, to) replaced; the message of its InputError, or "accepted".
+  auto messageFor = [](const std::vector<std::pair<std::string, std::string>>& edits) {
+    std::string text = kValid;
+    for (const auto& [from, to] : edits) {
+      const size_t at = text.find(from);
+      EXPECT_NE(at, std::string::npos) << from;
+      if (at != std::string::npos) text.replace(at, from.size(), to);
+    }
+    try {
+      parseScene(text, "scene.json");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(messageFor({{"\"particle_spacing\": 0.05", "\"particle_spacing\": NaN"}}),
+            "scene.json: particle_spacing: is NaN; numbers must be finite");
+  EXPECT_EQ(messageFor({{"\"max\": [1, 1, 0.5]", "\"max\": [1, Infinity, 0.5]"}}),
+            "scene.json: domain.max: is Infinity; numbers must be finite");
+  EXPECT_EQ(messageFor({{"\"dimensions\": 3", "\"dimensions\":-Infinity"}}),
+            "scene.json: dimensions: is -Infinity; numbers must be finite");
+  EXPECT_EQ(messageFor({{"\"name\": \"tiny\"", "\"name\": NaN"}}), "scene.json: name: is NaN; numbers must be finite");
+  // As text, and as part of a longer word, they are left alone: the scene named "NaN" is read on to its spacing.
+  EXPECT_EQ(messageFor({{"\"name\": \"tiny\"", "\"name\": \"NaN\""},
+                        {"\"particle_spacing\": 0.05", "\"particle_spacing\": NaN"}}),
+            "scene.json: particle_spacing: is NaN; numbers must be finite");
+  EXPECT_NE(messageFor({{"\"dimensions\": 3", "\"dimensions\": NaNa"}}).find("invalid JSON"), std::string::npos);
+}
+
 TEST(Scene, InvalidJsonNamesTheByte) {
   try {
     parseScene("{\"name\": \"x\",, }", "bad.json");
