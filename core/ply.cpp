@@ -1,6 +1,8 @@
 #include "core/ply.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -50,7 +52,31 @@ double readScalar(const char* p, const std::string& type) {
   return load(uint8_t{});
 }
 
-// A parsed binary PLY: the header and, per element, the raw bytes of its records.
+// Stores v as a value of `type` at p (little-endian, as readScalar reads it); false if the type cannot hold it
+// (an integer type given a fraction, or a number out of its range).
+bool storeScalar(char* p, const std::string& type, double v) {
+  auto store = [p](auto value) {
+    std::memcpy(p, &value, sizeof value);
+    return true;
+  };
+  auto integer = [&](auto zero, double lo, double hi) {
+    if (!(v >= lo && v <= hi) || v != std::floor(v)) return false;
+    return store(static_cast<decltype(zero)>(v));
+  };
+  if (type == "float" || type == "float32") return std::isfinite(v) && std::abs(v) <= 3.4e38 && store(float(v));
+  if (type == "double" || type == "float64") return std::isfinite(v) && store(v);
+  if (type == "int" || type == "int32") return integer(int32_t{}, -2147483648.0, 2147483647.0);
+  if (type == "uint" || type == "uint32") return integer(uint32_t{}, 0, 4294967295.0);
+  if (type == "short" || type == "int16") return integer(int16_t{}, -32768, 32767);
+  if (type == "ushort" || type == "uint16") return integer(uint16_t{}, 0, 65535);
+  if (type == "char" || type == "int8") return integer(int8_t{}, -128, 127);
+  return integer(uint8_t{}, 0, 255);
+}
+
+enum class PlyFormat { BinaryLittleEndian, BinaryBigEndian, Ascii };
+
+// A parsed PLY: the header and, per element, the bytes of its records as binary little-endian holds them (an
+// ASCII or big-endian body is converted as it is read, so that one reader serves all three formats).
 struct PlyFile {
   std::vector<PlyElement> elements;
   std::vector<std::string> comments;
@@ -68,6 +94,7 @@ PlyFile parsePly(const fs::path& path) {
     throw InputError(where, "line " + std::to_string(lineNumber), message);
   };
   bool sawFormat = false;
+  PlyFormat format = PlyFormat::BinaryLittleEndian;
   while (true) {
     if (!std::getline(in, line)) fail("header ends before end_header");
     ++lineNumber;
@@ -80,10 +107,12 @@ PlyFile parsePly(const fs::path& path) {
       continue;
     }
     if (word == "format") {
-      std::string format;
-      words >> format;
-      if (format != "binary_little_endian")
-        fail("format '" + format + "' is not supported (binary_little_endian)");
+      std::string name;
+      words >> name;
+      if (name == "binary_little_endian") format = PlyFormat::BinaryLittleEndian;
+      else if (name == "binary_big_endian") format = PlyFormat::BinaryBigEndian;
+      else if (name == "ascii") format = PlyFormat::Ascii;
+      else fail("format '" + name + "' is not one of ascii, binary_little_endian, binary_big_endian");
       sawFormat = true;
     } else if (word == "comment" || word == "obj_info") {
       file.comments.push_back(line.size() > 8 ? line.substr(8) : "");
@@ -120,6 +149,21 @@ PlyFile parsePly(const fs::path& path) {
   in.seekg(0, std::ios::end);
   const size_t bodySize = size_t(in.tellg() - bodyStart);
   in.seekg(bodyStart);
+  // One value of `type` from the body into buffer, as little-endian bytes; false at the end of the file or, in
+  // ASCII, at a word that is not a number the type holds.
+  auto readValue = [&](const std::string& type, char* buffer) {
+    const int size = typeSize(type);
+    if (format == PlyFormat::Ascii) {
+      std::string token;
+      if (!(in >> token)) return false;
+      char* end = nullptr;
+      const double v = std::strtod(token.c_str(), &end);
+      return end == token.c_str() + token.size() && storeScalar(buffer, type, v);
+    }
+    in.read(buffer, size);
+    if (format == PlyFormat::BinaryBigEndian) std::reverse(buffer, buffer + size);
+    return static_cast<bool>(in);
+  };
   for (const PlyElement& element : file.elements) {
     std::string bytes;
     bool hasList = false;
@@ -128,7 +172,7 @@ PlyFile parsePly(const fs::path& path) {
       hasList |= !p.countType.empty();
       recordSize += typeSize(p.type);
     }
-    if (!hasList) {
+    if (!hasList && format == PlyFormat::BinaryLittleEndian) {
       if (recordSize > 0 && element.count > bodySize / recordSize)
         throw InputError(where, "element " + element.name,
                          "file ends before its " + std::to_string(element.count) + " records");
@@ -138,29 +182,47 @@ PlyFile parsePly(const fs::path& path) {
         throw InputError(where, "element " + element.name,
                          "file ends before its " + std::to_string(element.count) + " records");
     } else {
-      // Lists: read record by record, keeping the raw bytes.
+      // Record by record (lists, or a body to convert), keeping little-endian bytes. A record takes at least a
+      // byte of the body, a list item its size (a byte in ASCII), which bounds what a file can claim before
+      // anything is allocated for it.
+      if (element.count > bodySize)
+        throw InputError(where, "element " + element.name,
+                         "file ends before its " + std::to_string(element.count) + " records");
+      auto ended = [&](size_t r) {
+        return InputError(where, "element " + element.name,
+                          format == PlyFormat::Ascii && in
+                              ? "record " + std::to_string(r) + " holds a word that is not a number of its type"
+                              : "file ends inside record " + std::to_string(r));
+      };
       for (size_t r = 0; r < element.count; ++r) {
         for (const PlyProperty& p : element.properties) {
           char buffer[8];
           if (p.countType.empty()) {
-            in.read(buffer, typeSize(p.type));
+            if (!readValue(p.type, buffer)) throw ended(r);
             bytes.append(buffer, typeSize(p.type));
             continue;
           }
-          in.read(buffer, typeSize(p.countType));
+          if (!readValue(p.countType, buffer)) throw ended(r);
           const double count = readScalar(buffer, p.countType);
           // A list's length: a whole number the rest of the file can hold (PLY readers elsewhere trust it).
-          if (!in || !(count >= 0) || count != std::floor(count) || count * typeSize(p.type) > double(bodySize))
+          const int leastItemBytes = format == PlyFormat::Ascii ? 1 : typeSize(p.type);
+          if (!(count >= 0) || count != std::floor(count) || count * leastItemBytes > double(bodySize))
             throw InputError(where, "element " + element.name,
                              "record " + std::to_string(r) + " has a list length that is not a count the file holds");
           const size_t items = static_cast<size_t>(count);
           bytes.append(buffer, typeSize(p.countType));
-          std::string items_bytes(items * typeSize(p.type), '\0');
-          in.read(items_bytes.data(), static_cast<std::streamsize>(items_bytes.size()));
-          bytes += items_bytes;
+          if (format == PlyFormat::BinaryLittleEndian) {  // the items as they stand, in one read
+            const size_t at = bytes.size();
+            bytes.resize(at + items * typeSize(p.type));
+            in.read(bytes.data() + at, static_cast<std::streamsize>(items * typeSize(p.type)));
+            if (!in) throw ended(r);
+            continue;
+          }
+          for (size_t k = 0; k < items; ++k) {
+            if (!readValue(p.type, buffer)) throw ended(r);
+            bytes.append(buffer, typeSize(p.type));
+          }
         }
-        if (!in)
-          throw InputError(where, "element " + element.name, "file ends inside record " + std::to_string(r));
       }
     }
     file.data.push_back(std::move(bytes));

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cstring>
 #include <fstream>
 #include <limits>
 
@@ -105,6 +108,54 @@ TEST(Ply, BadFilesNameFileAndPlace) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("bad.ply: vertex 7 vy: not a finite number"), std::string::npos)
         << e.what();
+  }
+}
+
+// A mesh as ASCII and as big-endian PLY (as users bring them: Blender and MeshLab write either, the Stanford
+// models are ASCII) reads as the same mesh as the little-endian file Surge writes: positions to the digits
+// written, faces as quads and triangles alike, extra properties passed over. A word that is not a number of its
+// property's type is refused, naming the record.
+TEST(Ply, AsciiAndBigEndianMeshesReadAsTheSameMesh) {
+  const fs::path path = tempPath("formats.ply");
+  const std::string header = "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                             "property uchar red\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  { std::ofstream(path) << "ply\nformat ascii 1.0\ncomment by hand\n" << header
+                         << "0 0 0 255\n1 0 0 255\n1 1 0 255\n0.5 1.5 -2.25 7\n4 0 1 2 3\n3 2 3 0\n"; }
+  const TriangleMesh ascii = readMeshPly(path);
+  const std::vector<Eigen::Vector3f> positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0.5f, 1.5f, -2.25f}};
+  const std::vector<std::array<uint32_t, 3>> triangles = {{0, 1, 2}, {0, 2, 3}, {2, 3, 0}};
+  EXPECT_EQ(ascii.positions, positions);
+  EXPECT_EQ(ascii.triangles, triangles);
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "ply\nformat binary_big_endian 1.0\n" << header;
+    auto big = [&](auto value) {
+      char bytes[sizeof value];
+      std::memcpy(bytes, &value, sizeof value);
+      std::reverse(bytes, bytes + sizeof value);
+      out.write(bytes, sizeof value);
+    };
+    for (const Eigen::Vector3f& p : positions) {
+      for (int k = 0; k < 3; ++k) big(p[k]);
+      big(uint8_t(255));
+    }
+    big(uint8_t(4));
+    for (int32_t i : {0, 1, 2, 3}) big(i);
+    big(uint8_t(3));
+    for (int32_t i : {2, 3, 0}) big(i);
+  }
+  const TriangleMesh bigEndian = readMeshPly(path);
+  EXPECT_EQ(bigEndian.positions, positions);
+  EXPECT_EQ(bigEndian.triangles, triangles);
+  for (const char* body : {"0 0 0 255\n1 0 0 255\n1 1 zero 255\n", "0 0 0 255\n1 0 0 256\n"}) {
+    { std::ofstream(path) << "ply\nformat ascii 1.0\n" << header << body; }
+    try {
+      readMeshPly(path);
+      ADD_FAILURE() << "accepted " << body;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("holds a word that is not a number of its type"), std::string::npos)
+          << e.what();
+    }
   }
 }
 
