@@ -43,7 +43,7 @@ std::string rangeText(const FieldInfo& info) {
 // Infinity and -Infinity, so scenes written by scripts hold them. A scene that does not parse is read again with
 // each such word (outside strings) turned into a marked string, so that the reader names the key that holds it
 // rather than a byte.
-const char kNonFiniteMark = '\x01';
+const char kNonFiniteMark = '\x01';  // written into the JSON text as the escape \u0001 (markNonFiniteWords)
 
 constexpr const char* kNonFiniteWords[] = {"NaN", "Infinity", "-Infinity"};
 

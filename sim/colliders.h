@@ -138,8 +138,8 @@ class Colliders {
   // Adds every collider's share of the density sums at p (as TankWalls::add does for the tank); `found` and,
   // for a single collider, its gradient `onlyGradient` say what it found.
   // A collider whose near box does not hold p is more than support + radius away, one that is not even a
-  // candidate more than the grid's margin further; a particle far from all (farFrom) is given the support alone,
-  // so that carry passes it by.
+  // candidate more than the grid's margin further; a particle far from all (farFrom) is given the support alone
+  // (it is further), so that add runs for it again at the next pass, where its cell check is all it costs.
   void add(const VecD& p, float& weight, VecD& gradient, Found& found, VecD& onlyGradient) const {
     found = Found{support_ + radius_ + kGridMargin * radius_, 0, 0};
     const bool near = forEachCandidate(
