@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include "core/parallel.h"
-#include "sim/particle_channels.h"
 
 namespace surge {
 namespace {
@@ -29,19 +28,10 @@ constexpr float kRelaxation = 0.5f;
 
 template <int Dim>
 DfsphSolver<Dim>::DfsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes)
-    : wendland_(scene.solver.kernel == "wendland_c2"),
-      cubicKernel_(static_cast<float>(scene.solver.kernel_radius)),
-      wendlandKernel_(static_cast<float>(scene.solver.kernel_radius)),
-      attractor_(scene.attractor),
-      grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
-            NeighborGrid<Dim>::cellSizeFor(static_cast<float>(scene.solver.kernel_radius))),
-      walls_(makeSphTankWalls<Dim>(scene)) {
-  if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
-  sceneSpeedLimit_ = static_cast<float>(runawaySpeed(scene));
+    : Core(scene, std::move(shapes), makeSphTankWalls<Dim>(scene), sphParticleMass<Dim>(scene)),
+      kernel_(sphKernel<Dim>(scene)) {
   const SolverSettings& s = scene.solver;
   support_ = static_cast<float>(s.kernel_radius);
-  restDensity_ = static_cast<float>(s.rest_density);
-  mass_ = sphParticleMass<Dim>(scene);
   volume_ = mass_ / restDensity_;
   spacing_ = static_cast<float>(scene.particle_spacing);
   maxDensityError_ = s.max_density_error;
@@ -51,18 +41,13 @@ DfsphSolver<Dim>::DfsphSolver(const Scene& scene, std::shared_ptr<const Collider
   maxStep_ = s.time_step > 0 ? static_cast<float>(s.time_step)
                              : static_cast<float>(1.0 / (scene.output.fps * std::max(1, s.substeps)));
   xsphC_ = static_cast<float>(s.xsph_c);
-  gravity_ = toVec<Dim>(scene.gravity);
 }
 
 template <int Dim>
-void DfsphSolver<Dim>::setParticles(const ParticleFrame& frame) {
-  readChannels(frame, x_, v_, id_);
-  const size_t n = frame.size();
+void DfsphSolver<Dim>::resizeChannels(size_t n) {
   densityWarm_.assign(n, 0.0f);
   divergenceWarm_.assign(n, 0.0f);
-  colliders_.resetSlots(n);
   prepared_ = false;
-  speedLimit_ = runawaySpeedFor(sceneSpeedLimit_, v_);
 }
 
 // The two solvers' lambda totals, particle by particle.
@@ -81,11 +66,6 @@ void DfsphSolver<Dim>::restoreCarriedState(const std::vector<float>& state) {
 }
 
 template <int Dim>
-void DfsphSolver<Dim>::getParticles(ParticleFrame& frame) const {
-  writeChannels(x_, v_, id_, frame);
-}
-
-template <int Dim>
 void DfsphSolver<Dim>::beginFrame(double) {
   framePressureMax_ = 0;
 }
@@ -93,7 +73,7 @@ void DfsphSolver<Dim>::beginFrame(double) {
 // The CFL condition on the fastest particle after a step's worth of gravity at most.
 template <int Dim>
 float DfsphSolver<Dim>::stableTimeStep() {
-  const VecD fall = maxStep_ * gravity_;
+  const VecD fall = maxStep_ * this->gravity_;
   std::vector<float>& speeds = floatScratch_;
   speeds.resize(size());
   parallelFor(0, size(), [&](size_t b, size_t e) {
@@ -109,39 +89,36 @@ long DfsphSolver<Dim>::step(float dt, double time) {
   applyNonPressureForces(dt, time);
 
   // Algorithm 3: the density solver on v*, then the move.
-  auto start = PhaseClock::now();
-  densityIterations_ = solve(true, dt, maxDensityError_, 2, densityWarm_);
-  lastStep_ = dt;
-  framePressureMax_ = std::max(framePressureMax_, restDensity_ / (dt * dt) * parallelMax(densityWarm_));
-  if (!colliders_.empty()) recordColliderImpulses(densityWarm_, dt);
-  times_.constraint += millisecondsSince(start);
+  {
+    const PhaseTimer timer(times_.pressure);
+    densityIterations_ = solve(true, dt, maxDensityError_, 2, densityWarm_);
+    lastStep_ = dt;
+    framePressureMax_ = std::max(framePressureMax_, restDensity_ / (dt * dt) * parallelMax(densityWarm_));
+    if (!colliders_.empty()) recordColliderImpulses(densityWarm_, dt);
+  }
   if (!colliders_.empty()) colliders_.beginStep(time, dt);
   driftAgainstSolids(x_, v_, dt, mass_, colliders_, walls_);
 
   // The new positions' neighbours and factors, and Algorithm 2: the divergence solver on v.
   prepareStep();
-  start = PhaseClock::now();
-  divergenceIterations_ = solve(false, dt, maxDivergenceError_, 1, divergenceWarm_);
-  if (!colliders_.empty()) recordColliderImpulses(divergenceWarm_, dt);
-  times_.constraint += millisecondsSince(start);
-  return firstParticleOutside(x_, v_, walls_, speedLimit_);
+  {
+    const PhaseTimer timer(times_.pressure);
+    divergenceIterations_ = solve(false, dt, maxDivergenceError_, 1, divergenceWarm_);
+    if (!colliders_.empty()) recordColliderImpulses(divergenceWarm_, dt);
+  }
+  return this->firstBadParticle();
 }
 
 template <int Dim>
 void DfsphSolver<Dim>::prepareStep() {
-  const auto start = PhaseClock::now();
-  grid_.sort(x_);
-  const std::vector<uint32_t>& order = grid_.sortedOrder();
-  gatherByOrder(order, x_, scratch_);
-  gatherByOrder(order, v_, scratch_);
-  gatherByOrder(order, id_, scratchIds_);
-  gatherByOrder(order, densityWarm_, floatScratch_);
-  gatherByOrder(order, divergenceWarm_, floatScratch_);
-  grid_.findNeighbors(x_, support_, neighbors_);
-  sizeForPairs(neighbors_, pairGradients_);
-  if (xsphC_ > 0) sizeForPairs(neighbors_, pairWeights_);
-  times_.neighbors += millisecondsSince(start);
-  withKernel([&](const auto& kernel) {
+  {
+    const PhaseTimer timer(times_.neighbors);
+    this->reorderByCell(x_, densityWarm_, divergenceWarm_);
+    this->findNeighborsOf(x_, support_);
+    sizeForPairs(neighbors_, pairGradients_);
+    if (xsphC_ > 0) sizeForPairs(neighbors_, pairWeights_);
+  }
+  kernel_.visit([&](const auto& kernel) {
     computeFactors(kernel);
     return 0;
   });
@@ -153,7 +130,7 @@ void DfsphSolver<Dim>::prepareStep() {
 template <int Dim>
 template <typename Kernel>
 void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
-  const auto start = PhaseClock::now();
+  const PhaseTimer timer(times_.pressure);
   const size_t n = size();
   densityRatio_.resize(n);
   diagonal_.resize(n);
@@ -198,35 +175,30 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
       diagonal_[i] = (sum + wallGradient_[i]).squaredNorm() + squares;
     }
   });
-  times_.constraint += millisecondsSince(start);
 }
 
 // v += dt (g + the attractor); then XSPH: v_i += c sum_j V (v_j - v_i) W_ij.
 template <int Dim>
 void DfsphSolver<Dim>::applyNonPressureForces(float dt, double time) {
-  const auto start = PhaseClock::now();
-  const bool attract = attractor_.active();
-  const VecD attractorAt = attract ? attractor_.position(time) : VecD::Zero();
+  const PhaseTimer timer(times_.forces);
+  const auto external = this->externalForces(dt, time);
   parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      v_[i] += dt * gravity_;
-      if (attract) v_[i] += dt * attractor_.acceleration(x_[i], attractorAt);
-    }
+    for (size_t i = b; i < e; ++i) external.kick(x_[i], v_[i]);
   });
   if (xsphC_ > 0) {
-    scratch_.resize(size());
+    std::vector<VecD>& smoothed = vectorScratch_;
+    smoothed.resize(size());
     const float scale = xsphC_ * volume_;
     parallelFor(0, size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
         VecD sum = VecD::Zero();
         const float* w = pairWeights_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
         for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++w) sum += (v_[*j] - v_[i]) * *w;
-        scratch_[i] = v_[i] + scale * sum;
+        smoothed[i] = v_[i] + scale * sum;
       }
     });
-    v_.swap(scratch_);
+    v_.swap(smoothed);
   }
-  times_.viscosity += millisecondsSince(start);
 }
 
 template <int Dim>
@@ -323,9 +295,8 @@ std::vector<float> DfsphSolver<Dim>::pressures() const {
 template <int Dim>
 FluidMeasures DfsphSolver<Dim>::measure() {
   if (!prepared_) prepareStep();
-  return withKernel([&](const auto& kernel) {
-    return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, Boundary<Dim>{walls_, colliders_}, mass_, restDensity_,
-                                        [&](float r2) { return kernel.value(std::sqrt(r2)); });
+  return kernel_.visit([&](const auto& kernel) {
+    return this->measureWith([&](float r2) { return kernel.value(std::sqrt(r2)); });
   });
 }
 

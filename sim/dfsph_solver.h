@@ -35,35 +35,22 @@
 
 #include <vector>
 
-#include "core/ply.h"
 #include "core/scene.h"
-#include "sim/attractor.h"
-#include "sim/colliders.h"
-#include "sim/fluid_solver.h"
 #include "sim/kernels.h"
-#include "sim/measures.h"
-#include "sim/neighbor_grid.h"
-#include "sim/tank.h"
+#include "sim/particle_solver.h"
 
 namespace surge {
 
 template <int Dim>
-class DfsphSolver final : public FluidSolver<Dim> {
+class DfsphSolver final : public ParticleSolver<Dim> {
  public:
   using VecD = Vec<Dim>;
+  using ParticleSolver<Dim>::size;
 
   explicit DfsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes = nullptr);
-  DfsphSolver(const DfsphSolver&) = delete;
-  DfsphSolver& operator=(const DfsphSolver&) = delete;
 
-  void setParticles(const ParticleFrame& frame) override;
   std::vector<float> carriedState() const override;
   void restoreCarriedState(const std::vector<float>& state) override;
-  void getParticles(ParticleFrame& frame) const override;
-  size_t size() const override { return x_.size(); }
-  const std::vector<VecD>& positions() const override { return x_; }
-  const std::vector<VecD>& velocities() const override { return v_; }
-  float particleMass() const override { return mass_; }
 
   int fixedSubsteps() const override { return 0; }
   float stableTimeStep() override;
@@ -77,10 +64,13 @@ class DfsphSolver final : public FluidSolver<Dim> {
   float maxPressure() const override { return framePressureMax_; }
   // Each particle's pressure in the last step's density solve, rho_0 lambda_i / dt^2, in the current order.
   std::vector<float> pressures() const;
-  PhaseTimes& phaseTimes() override { return times_; }
-  Colliders<Dim>& colliders() override { return colliders_; }
 
  private:
+  using Core = ParticleSolver<Dim>;
+  using Core::x_, Core::v_, Core::neighbors_, Core::walls_, Core::colliders_, Core::mass_, Core::times_;
+  using Core::restDensity_, Core::vectorScratch_, Core::floatScratch_;
+
+  void resizeChannels(size_t n) override;
   // Sorts the particles into the grid (reordering every channel) and computes, at the current positions, the
   // neighbour lists, each pair's g_ij, each particle's wall gradient G_i, density ratio and S_i.
   void prepareStep();
@@ -98,43 +88,25 @@ class DfsphSolver final : public FluidSolver<Dim> {
   // The impulses the colliders gave the particles through their share of G_i over this step's solves.
   void recordColliderImpulses(const std::vector<float>& lambda, float dt);
 
-  // Calls use(kernel) with the scene's SPH kernel.
-  template <typename Use>
-  auto withKernel(Use&& use) const {
-    return wendland_ ? use(wendlandKernel_) : use(cubicKernel_);
-  }
-
   // Parameters.
-  bool wendland_;
-  CubicSplineKernel<Dim> cubicKernel_;
-  WendlandC2Kernel<Dim> wendlandKernel_;
-  float support_, restDensity_, mass_, volume_, spacing_;
+  SphKernel<Dim> kernel_;
+  float support_, volume_, spacing_;
   double maxDensityError_, maxDivergenceError_;
   int maxIterations_;
   float cfl_, maxStep_, xsphC_;
-  VecD gravity_;
-  Attractor<Dim> attractor_;
 
-  // Particle channels.
-  std::vector<VecD> x_, v_, scratch_;
-  std::vector<uint32_t> id_, scratchIds_;
+  // DFSPH's channels beside the core's.
   std::vector<float> densityRatio_;  // rho_i / rho_0 at the current positions
   std::vector<float> diagonal_;      // S_i
   std::vector<VecD> wallGradient_;   // G_i, the tank's and the colliders'
   std::vector<float> wallFlux_;      // sum_c V v_c . grad W over the colliders (moving walls); only with colliders
-  std::vector<float> densityWarm_, divergenceWarm_, increments_, floatScratch_;
+  std::vector<float> densityWarm_, divergenceWarm_, increments_;
   std::vector<std::vector<VecD>> pairGradients_;  // g_ij, parallel to neighbors_
   std::vector<std::vector<float>> pairWeights_;   // W_ij for XSPH; only with xsph_c > 0
-  NeighborGrid<Dim> grid_;
-  TankWalls<Dim> walls_;
-  Colliders<Dim> colliders_;
-  NeighborLists neighbors_;
   bool prepared_ = false;  // the factors are those of the current positions
-  float sceneSpeedLimit_ = 0, speedLimit_ = 0;
 
   int densityIterations_ = 0, divergenceIterations_ = 0;
   float framePressureMax_ = 0, lastStep_ = 0;
-  PhaseTimes times_;
 };
 
 extern template class DfsphSolver<2>;

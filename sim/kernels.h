@@ -1,11 +1,13 @@
-// SPH smoothing kernels of Mueller et al. 2003 as used by Position Based Fluids (Macklin & Mueller 2013):
-// poly6 for density (PBF eq. 2) and the gradient of spiky for constraint gradients (PBF eq. 8). Templated on
-// the dimension; the 2D normalisations make each kernel integrate to one over the plane.
+// SPH smoothing kernels, templated on the dimension; the 2D normalisations make each integrate to one over the
+// plane. Kernels: poly6 and spiky (Mueller et al. 2003), as Position Based Fluids uses them (PBF eq. 2 and 8).
+// CubicSplineKernel and WendlandC2Kernel: the SPH methods' (WCSPH, DFSPH), chosen by `solver.kernel` through
+// SphKernel, the one place that reads that key.
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace surge {
 
@@ -146,6 +148,25 @@ class WendlandC2Kernel {
 
  private:
   float support_, inverseSupport_, sigma_;
+};
+
+// The scene's SPH kernel (`solver.kernel`, support `solver.kernel_radius`): visit(use) calls use(kernel) with
+// the chosen one, so that a method's loops are compiled for each kernel and pick one per pass, not per pair.
+template <int Dim>
+class SphKernel {
+ public:
+  SphKernel(const std::string& name, float support)
+      : wendland_(name == "wendland_c2"), cubic_(support), wendlandC2_(support) {}
+  float radius() const { return cubic_.radius(); }
+  template <typename Use>
+  decltype(auto) visit(Use&& use) const {
+    return wendland_ ? use(wendlandC2_) : use(cubic_);
+  }
+
+ private:
+  bool wendland_;
+  CubicSplineKernel<Dim> cubic_;
+  WendlandC2Kernel<Dim> wendlandC2_;
 };
 
 }  // namespace surge

@@ -1,5 +1,5 @@
 // What the frame loop reports of any solver: time per phase, the density error of DESIGN.md and the kinetic
-// energy, and the first particle that went bad. Shared by PBF and WCSPH.
+// energy, and the first particle that went bad. Shared by every method (sim/particle_solver.h).
 #pragma once
 
 #include <algorithm>
@@ -12,17 +12,31 @@
 
 namespace surge {
 
-// Milliseconds spent per phase, accumulated until reset. For WCSPH, "constraint" is density and pressure and
-// "viscosity" the force pass.
+// Milliseconds spent per phase, accumulated until reset, as stats.csv's columns: `neighbors` the sort, reorder
+// and lists (ms_neighbors); `pressure` the density or pressure solve (ms_constraint: PBF's constraint
+// iterations, WCSPH's density and equation of state, DFSPH's two solvers); `vorticity` (ms_vorticity); `forces`
+// the other forces (ms_viscosity: XSPH, and WCSPH's force pass).
 struct PhaseTimes {
-  double neighbors = 0, constraint = 0, vorticity = 0, viscosity = 0;
+  double neighbors = 0, pressure = 0, vorticity = 0, forces = 0;
 };
 
-// Milliseconds since `start`, for PhaseTimes.
 using PhaseClock = std::chrono::steady_clock;
 inline double millisecondsSince(PhaseClock::time_point start) {
   return std::chrono::duration<double, std::milli>(PhaseClock::now() - start).count();
 }
+
+// Adds the milliseconds of its own life to one of PhaseTimes' phases.
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(double& phase) : phase_(phase), start_(PhaseClock::now()) {}
+  ~PhaseTimer() { phase_ += millisecondsSince(start_); }
+  PhaseTimer(const PhaseTimer&) = delete;
+  PhaseTimer& operator=(const PhaseTimer&) = delete;
+
+ private:
+  double& phase_;
+  PhaseClock::time_point start_;
+};
 
 // Density error as DESIGN.md defines it (compression only, max(rho_i / rho_0 - 1, 0)) averaged and maximised
 // over the particles, and the kinetic energy.

@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include "core/parallel.h"
-#include "sim/particle_channels.h"
 #include "sim/tank.h"
 
 namespace surge {
@@ -25,35 +24,42 @@ inline float integerPower(float x, int n) {
 // may differ in the last bits), never on the thread count. A pair closer than coincidentLength_ (see
 // coincidentOffset) is rare; its particle is done again by the scalar loop beside.
 
-}  // namespace
+// The rest lattice's sums of poly6 and of the squared spiky gradient (eq. 2 and 8-9 over the lattice).
+template <int Dim>
+struct LatticeSums {
+  double weight = 0, gradientSquared = 0;
+  LatticeSums(const Scene& scene, const Kernels<Dim>& kernels) {
+    latticeSums<Dim>(static_cast<float>(scene.particle_spacing), kernels.radius(),
+                     [&](const Vec<Dim>& r) { return kernels.poly6(r.squaredNorm()); },
+                     [&](const Vec<Dim>& r) { return kernels.spikyGradient(r, r.norm()); }, &weight, &gradientSquared);
+  }
+};
 
 template <int Dim>
+TankWalls<Dim> pbfTankWalls(const Scene& scene, const Kernels<Dim>& kernels) {
+  return TankWalls<Dim>(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
+                        static_cast<float>(scene.particle_spacing), kernels.radius(),
+                        [&](const Vec<Dim>& r) { return kernels.poly6(r.squaredNorm()); },
+                        [&](const Vec<Dim>& r) { return kernels.spikyGradient(r, r.norm()); });
+}
+
+}  // namespace
+
+// The mass makes an interior particle of the rest lattice have exactly rho_0 (eq. 2 summed over the lattice),
+// so a block at rest starts unstressed and keeps its volume N x spacing^d.
+template <int Dim>
 PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes)
-    : kernels_(static_cast<float>(scene.solver.kernel_radius)),
-      attractor_(scene.attractor),
-      grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
-            NeighborGrid<Dim>::cellSizeFor(static_cast<float>(scene.solver.kernel_radius))),
-      walls_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max), static_cast<float>(scene.particle_spacing),
-             static_cast<float>(scene.solver.kernel_radius),
-             [&](const VecD& r) { return kernels_.poly6(r.squaredNorm()); },
-             [&](const VecD& r) { return kernels_.spikyGradient(r, r.norm()); }) {
-  if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
-  sceneSpeedLimit_ = static_cast<float>(runawaySpeed(scene));
+    : Core(scene, std::move(shapes), pbfTankWalls<Dim>(scene, Kernels<Dim>(float(scene.solver.kernel_radius))),
+           static_cast<float>(scene.solver.rest_density /
+                              LatticeSums<Dim>(scene, Kernels<Dim>(float(scene.solver.kernel_radius))).weight)),
+      kernels_(static_cast<float>(scene.solver.kernel_radius)) {
   substeps_ = scene.solver.substeps;
   const SolverSettings& s = scene.solver;
   const float spacing = static_cast<float>(scene.particle_spacing);
-  restDensity_ = static_cast<float>(s.rest_density);
-  // The mass makes an interior particle of the rest lattice have exactly rho_0 (eq. 2 summed over the lattice),
-  // so a block at rest starts unstressed and keeps its volume N x spacing^d.
-  double weightSum = 0, gradientSquaredSum = 0;
-  latticeSums<Dim>(spacing, kernels_.radius(), [&](const VecD& r) { return kernels_.poly6(r.squaredNorm()); },
-                   [&](const VecD& r) { return kernels_.spikyGradient(r, r.norm()); }, &weightSum,
-                   &gradientSquaredSum);
-  mass_ = static_cast<float>(s.rest_density / weightSum);
   massOverRho_ = mass_ / restDensity_;
   // sum_k |grad_k C_i|^2 at the rest lattice (eq. 8-9 with C_i = rho_i / rho_0 - 1): the scale of eq. 11's
   // denominator. epsilon is a fraction of it, s_corr is measured in lambda's units 1 / that sum.
-  latticeGradientSum_ = static_cast<float>(massOverRho_ * massOverRho_ * gradientSquaredSum);
+  latticeGradientSum_ = static_cast<float>(massOverRho_ * massOverRho_ * LatticeSums<Dim>(scene, kernels_).gradientSquared);
   epsilon_ = static_cast<float>(s.relaxation_epsilon) * latticeGradientSum_;
   coincidentLength_ = 1e-4f * kernels_.radius();
   scorrK_ = static_cast<float>(s.scorr_k);
@@ -70,29 +76,19 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
                       : 0.0f;
   iterations_ = s.iterations;
   maxDensityError_ = s.max_density_error;
-  gravity_ = toVec<Dim>(scene.gravity);
 }
 
 template <int Dim>
-void PbfSolver<Dim>::setParticles(const ParticleFrame& frame) {
-  readChannels(frame, x_, v_, id_);
-  const size_t n = frame.size();
+void PbfSolver<Dim>::resizeChannels(size_t n) {
   p_.resize(n);
   lambda_.assign(n, 0.0f);
   if (warmStart_ > 0) lambdaTotal_.assign(n, 0.0f);
-  colliders_.resetSlots(n);
   foundHolds_ = false;
   if (!colliders_.empty()) {
     found_.resize(n);
     onlyGradient_.resize(n);
   }
   if (vorticityEpsilon_ > 0) (Dim == 3 ? omega3_.resize(n) : omega2_.resize(n));
-  speedLimit_ = runawaySpeedFor(sceneSpeedLimit_, v_);
-}
-
-template <int Dim>
-void PbfSolver<Dim>::getParticles(ParticleFrame& frame) const {
-  writeChannels(x_, v_, id_, frame);
 }
 
 template <int Dim>
@@ -108,19 +104,17 @@ long PbfSolver<Dim>::step(float dt, double time) {
   if (vorticityEpsilon_ > 0) applyVorticityConfinement(dt);
   if (xsphC_ > 0) applyXsphViscosity();
   x_.swap(p_);  // line 23: x_i = x*_i
-  return firstParticleOutside(x_, v_, walls_, speedLimit_);
+  return this->firstBadParticle();
 }
 
 // Algorithm 1, lines 1-4: v_i += dt f_ext(x_i); x*_i = x_i + dt v_i. The walls act on x* at once. External
 // forces: gravity, and the attractor when the scene has one.
 template <int Dim>
 void PbfSolver<Dim>::predictPositions(float dt, double time) {
-  const bool attract = attractor_.active();
-  const VecD attractorAt = attract ? attractor_.position(time) : VecD::Zero();
+  const auto external = this->externalForces(dt, time);
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
-      v_[i] += dt * gravity_;
-      if (attract) v_[i] += dt * attractor_.acceleration(x_[i], attractorAt);
+      external.kick(x_[i], v_[i]);
       p_[i] = x_[i] + dt * v_[i];
       if (colliders_.empty()) {
         walls_.clamp(p_[i]);
@@ -173,18 +167,11 @@ void PbfSolver<Dim>::applyFriction() {
 // Lines 5-7: neighbours of x*. Particles are reordered by cell first, every step, for memory locality.
 template <int Dim>
 void PbfSolver<Dim>::findNeighbors() {
-  const auto start = PhaseClock::now();
-  grid_.sort(p_);
-  const std::vector<uint32_t>& order = grid_.sortedOrder();
-  gatherByOrder(order, x_, scratch_);
-  gatherByOrder(order, v_, scratch_);
-  gatherByOrder(order, p_, scratch_);
-  gatherByOrder(order, id_, scratchIds_);
-  if (!lambdaTotal_.empty()) gatherByOrder(order, lambdaTotal_, scratchFloats_);
-  if (foundHolds_) gatherByOrder(order, found_, scratchFound_);
-  grid_.findNeighbors(p_, kernels_.radius(), neighbors_);
+  const PhaseTimer timer(times_.neighbors);
+  this->reorderByCell(p_, lambdaTotal_);
+  if (foundHolds_) gatherByOrder(this->cellOrder(), found_, scratchFound_);
+  this->findNeighborsOf(p_, kernels_.radius());
   sizeForPairs(neighbors_, pairGradientFactors_);
-  times_.neighbors += millisecondsSince(start);
 }
 
 // Lines 8-19: Jacobi iterations on the density constraints. With solver.max_density_error > 0 the loop stops
@@ -208,7 +195,7 @@ void PbfSolver<Dim>::findNeighbors() {
 // SolverSettings::kChebyshevLeastIterations.
 template <int Dim>
 void PbfSolver<Dim>::solveDensityConstraints() {
-  const auto start = PhaseClock::now();
+  const PhaseTimer timer(times_.pressure);
   lastIterations_ = 0;
   if (warmStart_ > 0) applyWarmStart();
   const float rho2 = chebyshevRho_ * chebyshevRho_;
@@ -220,7 +207,6 @@ void PbfSolver<Dim>::solveDensityConstraints() {
     applyPositionCorrections<false>();
     ++lastIterations_;
   }
-  times_.constraint += millisecondsSince(start);
 }
 
 // The warm start: lambda_i = warm_start x the sum of particle i's lambdas last step, applied as one correction
@@ -345,7 +331,8 @@ template <bool kWarmStart>
 void PbfSolver<Dim>::applyPositionCorrections() {
   const bool scorr = scorrK_ > 0 && !kWarmStart;
   const bool sumLambdas = !kWarmStart && !lambdaTotal_.empty();
-  scratch_.resize(size());  // the corrections, applied after all are computed (Jacobi)
+  std::vector<VecD>& corrections = vectorScratch_;  // applied after all are computed (Jacobi)
+  corrections.resize(size());
   const float scorrScale = scorrK_ / latticeGradientSum_;
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
@@ -407,16 +394,16 @@ void PbfSolver<Dim>::applyPositionCorrections() {
       VecD wallGradient = VecD::Zero();
       walls_.add(p_[i], unusedWeight, wallGradient);
       delta += lambda_[i] * wallGradient;
-      scratch_[i] = massOverRho_ * delta;
+      corrections[i] = massOverRho_ * delta;
       // The colliders likewise; each one's share is an impulse it gives the particle.
       if (!colliders_.empty() && lambdaI != 0.0f && found_[i].count > 0)
-        scratch_[i] += colliderCorrection(i, pi, lambdaI);
+        corrections[i] += colliderCorrection(i, pi, lambdaI);
     }
   });
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const VecD before = p_[i];
-      p_[i] += scratch_[i];
+      p_[i] += corrections[i];
       if (colliders_.empty()) {
         walls_.clamp(p_[i]);
         continue;
@@ -466,7 +453,7 @@ void PbfSolver<Dim>::updateVelocities(float dt) {
 // The confinement force is applied as an acceleration: v_i += dt f_i.
 template <int Dim>
 void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
-  const auto start = PhaseClock::now();
+  const PhaseTimer timer(times_.vorticity);
   auto omegaMagnitude = [&](size_t j) { return Dim == 3 ? omega3_[j].norm() : std::abs(omega2_[j]); };
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
@@ -501,26 +488,25 @@ void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
       v_[i] += dt * force.head<Dim>();
     }
   });
-  times_.vorticity += millisecondsSince(start);
 }
 
 // Eq. 17: v_i <- v_i + c sum_j (m / rho_0) v_ij W(p_i - p_j, h), with v_ij = v_j - v_i. The factor m / rho_0
 // (the particle volume) makes c dimensionless, as the paper's c = 0.01 assumes unit particle volume.
 template <int Dim>
 void PbfSolver<Dim>::applyXsphViscosity() {
-  const auto start = PhaseClock::now();
-  scratch_.resize(size());
+  const PhaseTimer timer(times_.forces);
+  std::vector<VecD>& smoothed = vectorScratch_;
+  smoothed.resize(size());
   const float scale = xsphC_ * massOverRho_;
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       VecD sum = VecD::Zero();
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j)
         sum += (v_[*j] - v_[i]) * kernels_.poly6((p_[i] - p_[*j]).squaredNorm());
-      scratch_[i] = v_[i] + scale * sum;
+      smoothed[i] = v_[i] + scale * sum;
     }
   });
-  v_.swap(scratch_);
-  times_.viscosity += millisecondsSince(start);
+  v_.swap(smoothed);
 }
 
 // p_i - p_j, or coincidentOffset for a pair closer than coincidentLength_.
@@ -556,20 +542,16 @@ FluidMeasures PbfSolver<Dim>::measure() {
     p_ = x_;  // before the first step: neighbours of the current positions
     findNeighbors();
   }
-  return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, Boundary<Dim>{walls_, colliders_}, mass_, restDensity_,
-                                      [&](float r2) { return kernels_.poly6(r2); });
+  return this->measureWith([&](float r2) { return kernels_.poly6(r2); });
 }
 
 template <int Dim>
 size_t PbfSolver<Dim>::memoryBytes() const {
-  size_t bytes = (x_.capacity() + v_.capacity() + p_.capacity() + scratch_.capacity() + omega3_.capacity()) * sizeof(VecD);
-  bytes += (id_.capacity() + scratchIds_.capacity()) * sizeof(uint32_t);
-  bytes += (lambda_.capacity() + lambdaTotal_.capacity() + scratchFloats_.capacity() + omega2_.capacity()) *
-           sizeof(float);
+  size_t bytes = (p_.capacity() + omega3_.capacity() + onlyGradient_.capacity()) * sizeof(VecD);
+  bytes += (lambda_.capacity() + lambdaTotal_.capacity() + omega2_.capacity()) * sizeof(float);
   for (const auto& factors : pairGradientFactors_) bytes += factors.capacity() * sizeof(float);
-  bytes += (found_.capacity() + scratchFound_.capacity()) * sizeof(typename Colliders<Dim>::Found) +
-           onlyGradient_.capacity() * sizeof(VecD);
-  return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes();
+  bytes += (found_.capacity() + scratchFound_.capacity()) * sizeof(typename Colliders<Dim>::Found);
+  return bytes + this->coreMemoryBytes();
 }
 
 template class PbfSolver<2>;

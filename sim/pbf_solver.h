@@ -25,33 +25,21 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/ply.h"
 #include "core/scene.h"
-#include "sim/attractor.h"
 #include "sim/colliders.h"
-#include "sim/fluid_solver.h"
 #include "sim/kernels.h"
-#include "sim/measures.h"
-#include "sim/neighbor_grid.h"
-#include "sim/tank.h"
+#include "sim/particle_solver.h"
 
 namespace surge {
 
 template <int Dim>
-class PbfSolver final : public FluidSolver<Dim> {
+class PbfSolver final : public ParticleSolver<Dim> {
  public:
   using VecD = Vec<Dim>;
+  using ParticleSolver<Dim>::size;
 
   // `shapes`: the scene's collider shapes, built once by the caller; null builds them from the scene.
   explicit PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes = nullptr);
-
-  // Not copyable: the colliders point at the tank's walls of this object.
-  PbfSolver(const PbfSolver&) = delete;
-  PbfSolver& operator=(const PbfSolver&) = delete;
-
-  void setParticles(const ParticleFrame& frame) override;
-  void getParticles(ParticleFrame& frame) const override;
-  size_t size() const override { return x_.size(); }
 
   // The frame loop's interface (see sim/simulation.cpp): PBF takes the scene's substeps a frame.
   int fixedSubsteps() const override { return substeps_; }
@@ -66,17 +54,15 @@ class PbfSolver final : public FluidSolver<Dim> {
   std::vector<float> carriedState() const override { return lambdaTotal_; }
   void restoreCarriedState(const std::vector<float>& state) override;
   int lastIterations() const override { return lastIterations_; }
-  PhaseTimes& phaseTimes() override { return times_; }
-  uint32_t particleId(size_t i) const { return id_[i]; }
-  float particleMass() const override { return mass_; }
-  const std::vector<VecD>& positions() const override { return x_; }
-  const std::vector<VecD>& velocities() const override { return v_; }
-  const Colliders<Dim>& colliders() const { return colliders_; }
-  Colliders<Dim>& colliders() override { return colliders_; }
   // Bytes held by every particle channel, the grid, the neighbour lists and the pair factors (capacities).
   size_t memoryBytes() const;
 
  private:
+  using Core = ParticleSolver<Dim>;
+  using Core::x_, Core::v_, Core::neighbors_, Core::walls_, Core::colliders_, Core::mass_, Core::times_;
+  using Core::vectorScratch_, Core::restDensity_;
+
+  void resizeChannels(size_t n) override;
   void predictPositions(float dt, double time);
   void findNeighbors();
   void solveDensityConstraints();
@@ -97,13 +83,10 @@ class PbfSolver final : public FluidSolver<Dim> {
   // The offset p_i - p_j used for a pair closer than coincidentLength_ (see the .cpp).
   VecD coincidentOffset(size_t i, size_t j) const;
   VecD pairOffset(size_t i, size_t j, const VecD& pi) const;  // p_i - p_j, or the offset above
-  // Adds the walls' share of eq. 2 and eq. 8 for a particle at p: to the kernel weight sum and to
-  // sum_j grad W (both before the factor m or m / rho_0).
-  void addWallTerms(const VecD& p, float& weight, VecD& gradient) const;
 
   // Parameters, fixed at construction.
   Kernels<Dim> kernels_;
-  float restDensity_, mass_, massOverRho_, epsilon_, latticeGradientSum_;
+  float massOverRho_, epsilon_, latticeGradientSum_;
   float scorrK_, scorrInvWdq_, scorrAtRest_;
   int scorrN_;
   float coincidentLength_;
@@ -112,25 +95,14 @@ class PbfSolver final : public FluidSolver<Dim> {
   float chebyshevRho_;  // 0: plain Jacobi
   int iterations_;
   double maxDensityError_;
-  VecD gravity_;
   int substeps_;
-  Attractor<Dim> attractor_;
 
-  // Particle channels (structure of arrays) and the neighbour grid.
-  std::vector<VecD> x_, v_, p_;
-  std::vector<uint32_t> id_;
+  // PBF's channels beside the core's: the predicted positions x* and the multipliers.
+  std::vector<VecD> p_;
   std::vector<float> lambda_;
   std::vector<float> lambdaTotal_;  // the sums of each particle's lambdas this step; only with the warm start
-  std::vector<float> scratchFloats_;
   std::vector<VecD> omega3_;    // vorticity (3D); allocated only when vorticity confinement is on
   std::vector<float> omega2_;   // vorticity (2D, a scalar)
-  std::vector<VecD> scratch_;  // reordering, position corrections and XSPH velocities, in turn
-  std::vector<uint32_t> scratchIds_;
-  NeighborGrid<Dim> grid_;
-  TankWalls<Dim> walls_;
-  float sceneSpeedLimit_ = 0;  // runawaySpeed(scene)
-  float speedLimit_ = 0;       // and ten times the fastest particle given (runawaySpeedFor): faster is a blow-up
-  Colliders<Dim> colliders_;  // empty without colliders
   // What the colliders gave each particle at p_ in the lambda pass (or the warm start's), reused by the
   // correction that follows at the same positions; sized only with colliders.
   std::vector<typename Colliders<Dim>::Found> found_;
@@ -140,13 +112,11 @@ class PbfSolver final : public FluidSolver<Dim> {
   // last step's end when no collider moves.
   bool foundHolds_ = false;
   float stepDt_ = 0;          // the current step (turns collider displacements into impulses)
-  NeighborLists neighbors_;
   // Per neighbour pair, parallel to neighbors_: the spiky gradient factor g of Kernels::pair, computed by the
   // lambda pass and reused by the position-correction pass of the same iteration (same positions).
   std::vector<std::vector<float>> pairGradientFactors_;
 
   int lastIterations_ = 0;
-  PhaseTimes times_;
 };
 
 extern template class PbfSolver<2>;

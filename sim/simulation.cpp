@@ -73,7 +73,7 @@ std::string statsRow(int frame, double time, size_t particles, int substeps, dou
   char row[512];
   std::snprintf(row, sizeof row, "%d,%.6f,%zu,%d,%.2f,%.6g,%.6g,%.6g,%.4f,%.2f,%.2f,%.2f,%.2f,%.6g,", frame, time,
                 particles, substeps, iterations, m.densityErrorAvg, m.densityErrorMax, m.kineticEnergy,
-                wallSeconds, t.neighbors, t.constraint, t.vorticity, t.viscosity, timeStep);
+                wallSeconds, t.neighbors, t.pressure, t.vorticity, t.forces, timeStep);
   std::string text = row;
   if (!std::isnan(pressureMax)) {
     std::snprintf(row, sizeof row, "%.6g", pressureMax);

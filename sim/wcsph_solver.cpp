@@ -2,31 +2,22 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "core/parallel.h"
-#include "sim/particle_channels.h"
 
 namespace surge {
 
+// The mass gives the rest lattice exactly rho_0 (the same choice as PBF's, with this kernel).
 template <int Dim>
 WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes)
-    : wendland_(scene.solver.kernel == "wendland_c2"),
+    : Core(scene, std::move(shapes), makeSphTankWalls<Dim>(scene), sphParticleMass<Dim>(scene)),
       verlet_(scene.solver.integrator == "velocity_verlet"),
       tait_(scene.solver.equation_of_state == "tait"),
-      cubic_(static_cast<float>(scene.solver.kernel_radius)),
-      wendland_kernel_(static_cast<float>(scene.solver.kernel_radius)),
-      attractor_(scene.attractor),
-      grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
-            NeighborGrid<Dim>::cellSizeFor(static_cast<float>(scene.solver.kernel_radius))),
-      walls_(makeSphTankWalls<Dim>(scene)) {
-  if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
-  sceneSpeedLimit_ = static_cast<float>(runawaySpeed(scene));
+      kernel_(sphKernel<Dim>(scene)) {
   const SolverSettings& s = scene.solver;
   support_ = static_cast<float>(s.kernel_radius);
   smoothingLength_ = 0.5f * support_;
-  restDensity_ = static_cast<float>(s.rest_density);
-  // The mass gives the rest lattice exactly rho_0 (the same choice as PBF's, with this kernel).
-  mass_ = sphParticleMass<Dim>(scene);
   speedOfSound_ = static_cast<float>(s.speed_of_sound);
   gasConstant_ = static_cast<float>(s.gas_constant);
   taitB_ = restDensity_ * speedOfSound_ * speedOfSound_ / 7.0f;
@@ -35,26 +26,16 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const Collider
   nearStiffness_ = static_cast<float>(s.near_pressure);
   cfl_ = static_cast<float>(s.cfl);
   fixedStep_ = static_cast<float>(s.time_step);
-  gravity_ = toVec<Dim>(scene.gravity);
 }
 
 template <int Dim>
-void WcsphSolver<Dim>::setParticles(const ParticleFrame& frame) {
-  readChannels(frame, x_, v_, id_);
-  const size_t n = frame.size();
+void WcsphSolver<Dim>::resizeChannels(size_t n) {
   a_.assign(n, VecD::Zero());
   density_.assign(n, restDensity_);
   pressure_.assign(n, 0.0f);
   if (nearStiffness_ > 0) nearPressure_.assign(n, 0.0f);
-  colliders_.resetSlots(n);
   colliderForces_.assign(colliders_.size(), Wrench{});
   accelerationsValid_ = false;
-  speedLimit_ = runawaySpeedFor(sceneSpeedLimit_, v_);
-}
-
-template <int Dim>
-void WcsphSolver<Dim>::getParticles(ParticleFrame& frame) const {
-  writeChannels(x_, v_, id_, frame);
 }
 
 template <int Dim>
@@ -127,29 +108,28 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     accelerationsValid_ = false;
   }
   time_ = time + dt;
-  return firstParticleOutside(x_, v_, walls_, speedLimit_);
+  return this->firstBadParticle();
 }
 
 template <int Dim>
 void WcsphSolver<Dim>::computeAccelerations(double time) {
   // Neighbours of the current positions; every channel is reordered by cell first.
-  const auto start = PhaseClock::now();
-  grid_.sort(x_);
-  const std::vector<uint32_t>& order = grid_.sortedOrder();
-  gatherByOrder(order, x_, scratch_);
-  gatherByOrder(order, v_, scratch_);
-  gatherByOrder(order, id_, scratchIds_);
-  grid_.findNeighbors(x_, support_, neighbors_);
-  times_.neighbors += millisecondsSince(start);
-  if (wendland_) computeAccelerationsWith(wendland_kernel_, time);
-  else computeAccelerationsWith(cubic_, time);
+  {
+    const PhaseTimer timer(times_.neighbors);
+    this->reorderByCell(x_);
+    this->findNeighborsOf(x_, support_);
+  }
+  kernel_.visit([&](const auto& kernel) {
+    computeAccelerationsWith(kernel, time);
+    return 0;
+  });
   accelerationsValid_ = true;
 }
 
 template <int Dim>
 template <typename Kernel>
 void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double time) {
-  auto start = PhaseClock::now();
+  std::optional<PhaseTimer> timer(std::in_place, times_.pressure);
   const float selfWeight = kernel.value(0.0f);
   const bool near = nearStiffness_ > 0;
   const float inverseSupport = 1.0f / support_;
@@ -176,10 +156,9 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
     }
   });
   framePressureMax_ = std::max(framePressureMax_, parallelMax(pressure_));
-  times_.constraint += millisecondsSince(start);
 
   // Forces, gathered per particle.
-  start = PhaseClock::now();
+  timer.emplace(times_.forces);
   const VecD attractorAt = attractor_.active() ? attractor_.position(time) : VecD::Zero();
   const float h = smoothingLength_;
   const float eta2 = 0.01f * h * h;
@@ -230,17 +209,14 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
     }
   });
   if (!colliders_.empty()) colliderForces_ = colliders_.takeSlotSums();
-  times_.viscosity += millisecondsSince(start);
 }
 
 template <int Dim>
 FluidMeasures WcsphSolver<Dim>::measure() {
   if (neighbors_.size() != size()) computeAccelerations(time_);
-  auto sums = [&](const auto& kernel) {
-    return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, Boundary<Dim>{walls_, colliders_}, mass_, restDensity_,
-                                        [&](float r2) { return kernel.value(std::sqrt(r2)); });
-  };
-  return wendland_ ? sums(wendland_kernel_) : sums(cubic_);
+  return kernel_.visit([&](const auto& kernel) {
+    return this->measureWith([&](float r2) { return kernel.value(std::sqrt(r2)); });
+  });
 }
 
 template class WcsphSolver<2>;

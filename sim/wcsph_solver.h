@@ -20,33 +20,20 @@
 
 #include <vector>
 
-#include "core/ply.h"
 #include "core/scene.h"
-#include "sim/attractor.h"
-#include "sim/colliders.h"
-#include "sim/fluid_solver.h"
 #include "sim/kernels.h"
-#include "sim/neighbor_grid.h"
-#include "sim/measures.h"
-#include "sim/tank.h"
+#include "sim/particle_solver.h"
 
 namespace surge {
 
 template <int Dim>
-class WcsphSolver final : public FluidSolver<Dim> {
+class WcsphSolver final : public ParticleSolver<Dim> {
  public:
   using VecD = Vec<Dim>;
+  using ParticleSolver<Dim>::size;
 
   // `shapes`: the scene's collider shapes, built once by the caller; null builds them from the scene.
   explicit WcsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes = nullptr);
-
-  // Not copyable: the colliders point at the tank's walls of this object.
-  WcsphSolver(const WcsphSolver&) = delete;
-  WcsphSolver& operator=(const WcsphSolver&) = delete;
-
-  void setParticles(const ParticleFrame& frame) override;
-  void getParticles(ParticleFrame& frame) const override;
-  size_t size() const override { return x_.size(); }
 
   // Steps are chosen by the solver (stableTimeStep), not a fixed count per frame.
   int fixedSubsteps() const override { return 0; }
@@ -60,47 +47,35 @@ class WcsphSolver final : public FluidSolver<Dim> {
   FluidMeasures measure() override;
   float maxPressure() const override { return framePressureMax_; }
   int lastIterations() const override { return 0; }
-  PhaseTimes& phaseTimes() override { return times_; }
-  float particleMass() const override { return mass_; }
   float speedOfSound() const { return speedOfSound_; }
-  const std::vector<VecD>& positions() const override { return x_; }
-  const std::vector<VecD>& velocities() const override { return v_; }
-  const Colliders<Dim>& colliders() const { return colliders_; }
-  Colliders<Dim>& colliders() override { return colliders_; }
   // Pressures of the last evaluation, in the particles' current order (for tests).
   const std::vector<float>& pressures() const { return pressure_; }
 
  private:
+  using Core = ParticleSolver<Dim>;
+  using Core::x_, Core::v_, Core::neighbors_, Core::walls_, Core::colliders_, Core::mass_, Core::times_;
+  using Core::restDensity_, Core::gravity_, Core::attractor_;
+
+  void resizeChannels(size_t n) override;
   void computeAccelerations(double time);
   template <typename Kernel>
   void computeAccelerationsWith(const Kernel& kernel, double time);
 
   // Parameters.
-  bool wendland_, verlet_, tait_;
-  CubicSplineKernel<Dim> cubic_;
-  WendlandC2Kernel<Dim> wendland_kernel_;
-  float support_, smoothingLength_, restDensity_, mass_, speedOfSound_, gasConstant_, taitB_;
+  bool verlet_, tait_;
+  SphKernel<Dim> kernel_;
+  float support_, smoothingLength_, speedOfSound_, gasConstant_, taitB_;
   float alpha_, nu_, nearStiffness_, cfl_, fixedStep_;
-  VecD gravity_;
-  Attractor<Dim> attractor_;
 
-  // Particle channels.
-  std::vector<VecD> x_, v_, a_, scratch_;
-  std::vector<uint32_t> id_, scratchIds_;
+  // WCSPH's channels beside the core's.
+  std::vector<VecD> a_;
   std::vector<float> density_, pressure_;
   std::vector<float> nearPressure_;  // only with near_pressure > 0
-  NeighborGrid<Dim> grid_;
-  TankWalls<Dim> walls_;
-  float sceneSpeedLimit_ = 0;  // runawaySpeed(scene)
-  float speedLimit_ = 0;       // and ten times the fastest particle given (runawaySpeedFor): faster is a blow-up
-  Colliders<Dim> colliders_;             // empty without colliders
   std::vector<Wrench> colliderForces_;   // each collider's force at the last evaluation (for the impulses)
-  NeighborLists neighbors_;
 
   bool accelerationsValid_ = false;
   double time_ = 0;  // the simulated time of the current state (moves the attractor)
   float framePressureMax_ = 0;
-  PhaseTimes times_;
 };
 
 extern template class WcsphSolver<2>;

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "sim/particle_channels.h"
+#include "sim/particle_solver.h"
 #include "sim/pbf_solver.h"
 #include "sim/simulation.h"
 #include "sim/fluid_solver.h"

@@ -1,0 +1,157 @@
+// The particle core every fluid method is built on. It holds what the methods share: the particles (positions,
+// velocities, ids), the neighbour grid and lists and the reorder of every channel by cell, the tank's walls, the
+// colliders and bodies the fluid meets, gravity and the attractor, the runaway-speed check, the measures of
+// stats.csv and the phase timers; and it implements the part of FluidSolver (sim/fluid_solver.h) that is the
+// same for all of them. A method derives from ParticleSolver and keeps only its own phases and channels, so its
+// .cpp reads as its paper's algorithm.
+//
+// It is a base class rather than a state object each method holds: the loops of a method read x_, v_ and the
+// neighbour lists directly (no accessor per particle), and FluidSolver's bookkeeping is written once.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/ply.h"
+#include "core/scene.h"
+#include "sim/attractor.h"
+#include "sim/colliders.h"
+#include "sim/fluid_solver.h"
+#include "sim/kernels.h"
+#include "sim/measures.h"
+#include "sim/neighbor_grid.h"
+#include "sim/tank.h"
+
+namespace surge {
+
+template <int Dim>
+Vec<Dim> toVec(const Eigen::Vector3d& v) {
+  return v.head<Dim>().template cast<float>();
+}
+
+// The scene's SPH kernel (WCSPH, DFSPH).
+template <int Dim>
+SphKernel<Dim> sphKernel(const Scene& scene) {
+  return SphKernel<Dim>(scene.solver.kernel, static_cast<float>(scene.solver.kernel_radius));
+}
+
+// The tank's walls seen through the scene's SPH kernel.
+template <int Dim>
+TankWalls<Dim> makeSphTankWalls(const Scene& scene);
+
+// The particle mass that gives the rest lattice of the scene's spacing exactly rest_density with the scene's SPH
+// kernel (PBF's, with poly6, is in its solver).
+template <int Dim>
+float sphParticleMass(const Scene& scene);
+
+template <int Dim>
+class ParticleSolver : public FluidSolver<Dim> {
+ public:
+  using VecD = Vec<Dim>;
+
+  // Not copyable: the colliders point at the tank's walls of this object.
+  ParticleSolver(const ParticleSolver&) = delete;
+  ParticleSolver& operator=(const ParticleSolver&) = delete;
+
+  void setParticles(const ParticleFrame& frame) final;
+  void getParticles(ParticleFrame& frame) const final;
+  size_t size() const final { return x_.size(); }
+  const std::vector<VecD>& positions() const final { return x_; }
+  const std::vector<VecD>& velocities() const final { return v_; }
+  float particleMass() const final { return mass_; }
+  uint32_t particleId(size_t i) const { return id_[i]; }
+  PhaseTimes& phaseTimes() final { return times_; }
+  Colliders<Dim>& colliders() final { return colliders_; }
+  const Colliders<Dim>& colliders() const { return colliders_; }
+
+ protected:
+  // `walls`: the tank seen through the method's kernel; `mass`: the particle mass that gives the rest lattice
+  // exactly rest_density with that kernel. `shapes`: the scene's collider shapes, null builds them.
+  ParticleSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, TankWalls<Dim> walls, float mass);
+
+  // The method's own channels, sized for the n particles setParticles was given.
+  virtual void resizeChannels(size_t n) = 0;
+
+  // Sorts the particles into the grid at `key` (x_, or a method's predicted positions) and reorders x_, v_, id_,
+  // `key` and every channel given by cell, so that neighbours are close in memory; an empty channel is skipped.
+  // cellOrder() is then the order, for a channel of another type.
+  template <typename... Channels>
+  void reorderByCell(std::vector<VecD>& key, Channels&... channels);
+  const std::vector<uint32_t>& cellOrder() const { return grid_.sortedOrder(); }
+  // The neighbour lists of the positions `at`, as the last reorderByCell sorted them.
+  void findNeighborsOf(const std::vector<VecD>& at, float radius) { grid_.findNeighbors(at, radius, neighbors_); }
+
+  // Gravity and the attractor (at `time`) as velocity changes of a step dt: kick(i, v) adds them to v.
+  struct ExternalForces {
+    const ParticleSolver& core;
+    float dt;
+    bool attract;
+    VecD attractorAt;
+    void kick(const VecD& x, VecD& v) const {
+      v += dt * core.gravity_;
+      if (attract) v += dt * core.attractor_.acceleration(x, attractorAt);
+    }
+  };
+  ExternalForces externalForces(float dt, double time) const {
+    const bool attract = attractor_.active();
+    return {*this, dt, attract, attract ? attractor_.position(time) : VecD::Zero()};
+  }
+
+  // The measures of stats.csv at x_ with the current neighbour lists; weight(r2) is the method's density kernel
+  // as a function of the squared distance.
+  template <typename Weight>
+  FluidMeasures measureWith(Weight weight) const {
+    return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, Boundary<Dim>{walls_, colliders_}, mass_, restDensity_,
+                                        weight);
+  }
+  // The first particle that is not finite, left the tank or ran away (firstParticleOutside), or -1.
+  long firstBadParticle() const { return firstParticleOutside(x_, v_, walls_, speedLimit_); }
+  // Bytes held by the shared channels, the grid, the lists and the colliders (capacities).
+  size_t coreMemoryBytes() const;
+
+  // Parameters, fixed at construction.
+  const float restDensity_, mass_;
+  const VecD gravity_;
+  const Attractor<Dim> attractor_;
+
+  // The particles (structure of arrays), the grid, the walls and the colliders.
+  std::vector<VecD> x_, v_;
+  std::vector<uint32_t> id_;
+  NeighborGrid<Dim> grid_;
+  NeighborLists neighbors_;
+  TankWalls<Dim> walls_;
+  Colliders<Dim> colliders_;  // empty without colliders and bodies
+  // Scratch a method may use between its own passes; reorderByCell uses them too.
+  std::vector<VecD> vectorScratch_;
+  std::vector<float> floatScratch_;
+  std::vector<uint32_t> idScratch_;
+  PhaseTimes times_;
+
+ private:
+  std::vector<VecD>& scratchFor(std::vector<VecD>&) { return vectorScratch_; }
+  std::vector<float>& scratchFor(std::vector<float>&) { return floatScratch_; }
+  std::vector<uint32_t>& scratchFor(std::vector<uint32_t>&) { return idScratch_; }
+
+  float sceneSpeedLimit_;  // runawaySpeed(scene)
+  float speedLimit_ = 0;   // and ten times the fastest particle given (runawaySpeedFor): faster is a blow-up
+};
+
+template <int Dim>
+template <typename... Channels>
+void ParticleSolver<Dim>::reorderByCell(std::vector<VecD>& key, Channels&... channels) {
+  grid_.sort(key);
+  const std::vector<uint32_t>& order = grid_.sortedOrder();
+  gatherByOrder(order, x_, vectorScratch_);
+  gatherByOrder(order, v_, vectorScratch_);
+  if (&key != &x_) gatherByOrder(order, key, vectorScratch_);
+  gatherByOrder(order, id_, idScratch_);
+  [[maybe_unused]] auto gather = [&](auto& channel) {
+    if (!channel.empty()) gatherByOrder(order, channel, scratchFor(channel));
+  };
+  (gather(channels), ...);
+}
+
+extern template class ParticleSolver<2>;
+extern template class ParticleSolver<3>;
+
+}  // namespace surge
