@@ -9,6 +9,7 @@
 #include "core/parallel.h"
 #include "sim/rigid_bodies.h"
 #include "sim/simulation.h"
+#include "sim/solver_defaults.h"
 
 namespace surge {
 
@@ -87,11 +88,7 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
       say(options, line);
     }
   }
-  if (scene.solver.method == "pbf" && stableSubsteps(scene) > scene.solver.substeps)
-    say(options, "sim: note: solver.substeps " + std::to_string(scene.solver.substeps) + " is below the " +
-                     std::to_string(stableSubsteps(scene)) +
-                     " a PBF pool this deep needs to stay at rest (dt <= 0.9 particle_spacing / sqrt(g depth)); "
-                     "leave it out to get them");
+  for (const std::string& note : solverNotes(scene)) say(options, "sim: note: " + note);
   const std::string json = sceneToJson(scene);
   std::error_code error;
   const bool existing = fs::exists(dir / "scene.json", error);

@@ -22,6 +22,7 @@
 #include "apps/study.h"
 #include "core/errors.h"
 #include "sim/simulation.h"
+#include "sim/solver_defaults.h"
 
 extern char** environ;
 

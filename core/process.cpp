@@ -5,9 +5,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <sstream>
 
 #include "core/errors.h"
@@ -89,6 +91,31 @@ ProgramResult runProgram(const fs::path& program, const std::vector<std::string>
   }
   if (WIFEXITED(status)) result.exitCode = WEXITSTATUS(status);
   return result;
+}
+
+MemoryLimit memoryLimit() {
+  MemoryLimit limit{double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE)), "this machine's"};
+  auto lower = [&](double bytes, const char* source) {
+    if (bytes > 0 && bytes < limit.bytes) limit = {bytes, source};
+  };
+  // A number of bytes in a file ("max" or a huge value means no limit).
+  auto fileBytes = [](const char* path) {
+    std::ifstream in(path);
+    std::string text;
+    if (!(in >> text) || text.empty() || !std::isdigit(static_cast<unsigned char>(text[0]))) return 0.0;
+    return std::strtod(text.c_str(), nullptr);
+  };
+  lower(fileBytes("/sys/fs/cgroup/memory.max"), "this cgroup's");                        // cgroup v2
+  lower(fileBytes("/sys/fs/cgroup/memory/memory.limit_in_bytes"), "this cgroup's");      // cgroup v1
+  auto environment = [](const char* name) {
+    const char* value = std::getenv(name);
+    return value ? std::strtod(value, nullptr) : 0.0;
+  };
+  // Slurm's --mem and --mem-per-cpu, in MB, which hold even where Slurm does not enforce them with cgroups.
+  lower(environment("SLURM_MEM_PER_NODE") * 1048576.0, "this Slurm job's");
+  lower(environment("SLURM_MEM_PER_CPU") * 1048576.0 * std::max(1.0, environment("SLURM_CPUS_ON_NODE")),
+        "this Slurm job's");
+  return limit;
 }
 
 }  // namespace surge

@@ -510,8 +510,6 @@ void validate(Scene& s, const std::string& where) {
                      "the fluid boxes hold no particles at particle_spacing " + formatNumber(spacing));
 
   SolverSettings& solver = s.solver;
-  if (solver.substeps == 0) solver.substeps = std::max(4, stableSubsteps(s));
-  if (solver.method == "dfsph" && solver.max_density_error == 0) solver.max_density_error = 0.0005;
   if (solver.kernel_radius == 0) solver.kernel_radius = 2 * spacing;
   if (solver.kernel_radius <= spacing)
     throw InputError(where, "solver.kernel_radius", "must exceed particle_spacing, or particles have no neighbours");
@@ -520,14 +518,6 @@ void validate(Scene& s, const std::string& where) {
     if ((s.domain.max[k] - s.domain.min[k]) / solver.kernel_radius > double(1 << 20))
       throw InputError(where, "domain", "spans more than 2^20 kernel radii along an axis");
 
-  if (solver.speed_of_sound == 0) {
-    // Ten times the fastest the water can move by falling through the tank (or by its initial velocity):
-    // density then varies by about 1% (Monaghan 1994).
-    double speed = std::sqrt(2 * s.gravity.norm() * (s.domain.max - s.domain.min)[1]);
-    for (const FluidBlock& fluid : s.fluids) speed = std::max(speed, fluid.velocity.norm());
-    solver.speed_of_sound = 10 * std::max(speed, 1.0);
-  }
-  if (solver.gas_constant == 0) solver.gas_constant = solver.speed_of_sound * solver.speed_of_sound;
   for (size_t i = 1; i < s.attractor.keyframes.size(); ++i)
     if (s.attractor.keyframes[i].time < s.attractor.keyframes[i - 1].time)
       throw InputError(where, "attractor.keyframes[" + std::to_string(i) + "].time", "keyframes must be in time order");
@@ -561,6 +551,8 @@ void validate(Scene& s, const std::string& where) {
     camera.look_at = centre - (d == 2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0, 0.15 * extent.y(), 0));
     camera.position = camera.look_at + distance * direction;
   }
+  // The simulator's defaults (sim/solver_defaults.cpp), where the program has the simulator.
+  if (solverDefaults()) solverDefaults()(s);
 }
 
 }  // namespace
@@ -581,18 +573,6 @@ size_t Scene::particleCount() const {
     total += size_t(n[0]) * size_t(n[1]) * size_t(n[2]);
   }
   return total;
-}
-
-size_t bytesPerParticleEstimate(int dimensions, const std::string& method) {
-  // PBF (the extremes tests and bench/sim_bench.cpp; WCSPH needs less): in 3D about 340 bytes of solver arrays
-  // (positions, velocities, predictions and their scratch copy 4 x 12; ids, lambdas and the grid's 16; about 30
-  // neighbours and their stored gradient factors at 4 bytes each, with slack, 280), the 28-byte frame being
-  // written, and room for the allocator: 400. In 2D, 13 neighbours instead of 30: 250.
-  // DFSPH stores a gradient vector and a kernel weight per pair instead of a factor (30 x 12 bytes more in 3D,
-  // 13 x 8 in 2D) and five more floats and a vector a particle; measured at 3.3 million particles before the
-  // weights, 679 bytes peak: 800 and 360.
-  if (method == "dfsph") return dimensions == 3 ? 800 : 360;
-  return dimensions == 3 ? 400 : 250;
 }
 
 Scene parseScene(const std::string& text, const std::string& where, const std::vector<std::string>& overrides) {
@@ -631,57 +611,14 @@ Scene parseScene(const std::string& text, const std::string& where, const std::v
   return scene;
 }
 
-int stableSubsteps(const Scene& scene) {
-  const int d = scene.dimensions;
-  const Eigen::VectorXd gravity = scene.gravity.head(d);
-  const double g = gravity.norm();
-  if (!(g > 0)) return 1;
-  // The depth of the pool the fluid settles into: its volume over the tank's floor, the floor being the tank's
-  // section across the axis gravity is mostly along.
-  int down = 0;
-  gravity.cwiseAbs().maxCoeff(&down);
-  double floor = 1, volume = 0;
-  for (int k = 0; k < d; ++k)
-    if (k != down) floor *= scene.domain.max[k] - scene.domain.min[k];
-  for (const FluidBlock& fluid : scene.fluids) volume += (fluid.box.max - fluid.box.min).head(d).prod();
-  const double depth = std::min(volume / floor, scene.domain.max[down] - scene.domain.min[down]);
-  if (!(depth > 0)) return 1;
-  const double longest = 0.9 * scene.particle_spacing / std::sqrt(g * depth);
-  const double steps = std::ceil(1.0 / (scene.output.fps * longest) - 1e-9);
-  return int(std::min(steps, 100000.0));
+SolverDefaults& solverDefaults() {
+  static SolverDefaults resolve = nullptr;
+  return resolve;
 }
 
-double runawaySpeed(const Scene& scene) {
-  const int d = scene.dimensions;
-  const double diagonal = (scene.domain.max - scene.domain.min).head(d).norm();
-  double fluid = 0, bodies = 0, colliders = 0, attractor = 0;
-  for (const FluidBlock& block : scene.fluids) fluid = std::max(fluid, block.velocity.head(d).norm());
-  for (const BodySettings& body : scene.bodies)
-    bodies = std::max(bodies, body.velocity.head(d).norm() + body.angular_velocity.norm() * diagonal);
-  for (const ColliderSettings& collider : scene.colliders)
-    for (size_t k = 1; k < collider.motion.size(); ++k) {
-      const ColliderKeyframe &a = collider.motion[k - 1], &b = collider.motion[k];
-      const double dt = b.time - a.time;
-      if (!(dt > 0)) continue;
-      const double turn = std::abs(b.rotation.degrees - a.rotation.degrees) * M_PI / 180.0 +
-                          (a.rotation.axis != b.rotation.axis ? 2 * M_PI : 0.0);
-      colliders = std::max(colliders, ((b.position - a.position).head(d).norm() + turn * diagonal) / dt);
-    }
-  if (!scene.attractor.keyframes.empty()) {
-    double moving = 0;  // the attractor's fastest keyframed speed
-    for (size_t k = 1; k < scene.attractor.keyframes.size(); ++k) {
-      const AttractorKeyframe &a = scene.attractor.keyframes[k - 1], &b = scene.attractor.keyframes[k];
-      if (b.time > a.time) moving = std::max(moving, (b.position - a.position).head(d).norm() / (b.time - a.time));
-    }
-    attractor = std::sqrt(std::abs(scene.attractor.strength) * scene.attractor.radius) + moving;
-  }
-  const double fall = std::sqrt(2 * scene.gravity.head(d).norm() * diagonal);
-  // PBF's projection moves a particle up to about a spacing a step, and the velocity is that move over the step;
-  // WCSPH's pressure only turns the energy of compression, which the fall gave, back into motion, and is given a
-  // spacing a frame, so that a scene with nothing moving (no gravity) still has a limit above zero.
-  const double solver = scene.particle_spacing * scene.output.fps *
-                        (scene.solver.method == "wcsph" ? 1 : std::max(1, scene.solver.substeps));
-  return 10 * (fluid + bodies + 2 * colliders + attractor + fall + solver);
+std::vector<SolverMethodEntry>& solverMethodCatalog() {
+  static std::vector<SolverMethodEntry> methods;
+  return methods;
 }
 
 std::vector<SolidFiles> solidFiles(const Scene& scene) {
@@ -701,41 +638,6 @@ Scene loadScene(const fs::path& path, const std::vector<std::string>& overrides)
   for (ColliderSettings& c : scene.colliders) resolve(c);
   for (BodySettings& b : scene.bodies) resolve(b.solid);
   return scene;
-}
-
-MemoryLimit memoryLimit() {
-  MemoryLimit limit{double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE)), "this machine's"};
-  auto lower = [&](double bytes, const char* source) {
-    if (bytes > 0 && bytes < limit.bytes) limit = {bytes, source};
-  };
-  // A number of bytes in a file ("max" or a huge value means no limit).
-  auto fileBytes = [](const char* path) {
-    std::ifstream in(path);
-    std::string text;
-    if (!(in >> text) || text.empty() || !std::isdigit(static_cast<unsigned char>(text[0]))) return 0.0;
-    return std::strtod(text.c_str(), nullptr);
-  };
-  lower(fileBytes("/sys/fs/cgroup/memory.max"), "this cgroup's");                        // cgroup v2
-  lower(fileBytes("/sys/fs/cgroup/memory/memory.limit_in_bytes"), "this cgroup's");      // cgroup v1
-  auto environment = [](const char* name) {
-    const char* value = std::getenv(name);
-    return value ? std::strtod(value, nullptr) : 0.0;
-  };
-  // Slurm's --mem and --mem-per-cpu, in MB, which hold even where Slurm does not enforce them with cgroups.
-  lower(environment("SLURM_MEM_PER_NODE") * 1048576.0, "this Slurm job's");
-  lower(environment("SLURM_MEM_PER_CPU") * 1048576.0 * std::max(1.0, environment("SLURM_CPUS_ON_NODE")),
-        "this Slurm job's");
-  return limit;
-}
-
-void checkSimulationMemory(const Scene& scene) {
-  const size_t count = scene.particleCount();
-  const double bytes = double(count) * double(bytesPerParticleEstimate(scene.dimensions, scene.solver.method));
-  const MemoryLimit memory = memoryLimit();
-  if (count > (size_t(1) << 31) || bytes > 0.8 * memory.bytes)
-    throw InputError(scene.source, "particle_spacing",
-                     std::to_string(count) + " particles need about " + formatBytes(bytes) + " to simulate, more than " +
-                         memory.source + " " + formatBytes(memory.bytes) + " allow (80%)");
 }
 
 std::string sceneToJson(const Scene& scene) {

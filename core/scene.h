@@ -188,24 +188,17 @@ struct SolidFiles {
 // The scene's colliders, then its bodies.
 std::vector<SolidFiles> solidFiles(const Scene& scene);
 
-// The fewest steps a frame with which a PBF column of fluid stays at rest. Each step gravity moves every
-// particle by g dt^2, and a column H deep of H / spacing layers sags by g dt^2 H / spacing before the Jacobi
-// iterations push it back; once that nears a spacing, layers pass through each other and a pool at rest boils
-// (measured: a 2D pool 0.3 m deep at spacing 0.01 reached 350 J/m of kinetic energy at 4 steps a frame and
-// stayed at 0.1 at 8; the boundary fell at dt sqrt(g H) / spacing = 1.12 in 2D and about 1.0 in 3D, for
-// spacings 0.005 to 0.02). So dt <= 0.9 spacing / sqrt(|g| H), with H the depth of the pool the fluid settles
-// into (its volume over the tank's floor): a column that falls, as a dam break's, holds its height too briefly
-// to boil, and is not counted at its height.
-int stableSubsteps(const Scene& scene);
-// solver.substeps 0 (the default) resolves to max(4, stableSubsteps); a number given is taken as it is.
-
-// The speed that marks a particle as run away (a diverged solver): ten times the fastest the scene can give a
-// particle, which is the sum of its initial speeds (fluid, bodies, with their spin over the tank's diagonal),
-// twice the fastest collider (a wall moving at V throws what it meets at up to 2 V), the attractor's pull
-// (sqrt(strength radius), the speed of a fall into it) and its own speed, a free fall across the tank's diagonal
-// (sqrt(2 g L)), and the solver's own push (PBF: a spacing a step; WCSPH: a spacing a frame). Stable runs stay
-// well under a tenth of it; a blow-up passes it within a few steps.
-double runawaySpeed(const Scene& scene);
+// The simulator's defaults for what the file left 0 (solver.substeps, speed_of_sound, ...): they come from the
+// methods' physics, so sim/ installs the function that resolves them (sim/solver_defaults.h) and the scene
+// reader calls it last; a program without the simulator reads those keys as the file gives them.
+using SolverDefaults = void (*)(Scene&);
+SolverDefaults& solverDefaults();
+// The methods `solver.method` may name, with the line each adds to the key's description, in the order of sim/'s
+// registry, which fills this list wherever the simulator is linked (sim/fluid_solver.cpp); empty, any name is read.
+struct SolverMethodEntry {
+  std::string name, description;
+};
+std::vector<SolverMethodEntry>& solverMethodCatalog();
 
 // Lattice points of one fluid box: counts per axis (1 on unused axes in 2D).
 Eigen::Array3i latticeCounts(const Scene& scene, const Box& box);
@@ -231,22 +224,5 @@ fs::path writeStageSettings(const fs::path& dir, const std::string& stage, const
 
 // A markdown table of every key: path, type, default, allowed values, meaning.
 std::string sceneKeysMarkdown();
-
-// Bytes the simulator's `method` needs per particle at peak, for the memory check and for reporting.
-size_t bytesPerParticleEstimate(int dimensions, const std::string& method = "pbf");
-
-// The memory this process may use: the least of the machine's physical memory, its cgroup's limit (v2
-// memory.max, v1 memory.limit_in_bytes) and a Slurm job's (SLURM_MEM_PER_NODE, or SLURM_MEM_PER_CPU times
-// SLURM_CPUS_ON_NODE), and which of them it is ("this machine's", "this cgroup's", "this Slurm job's").
-struct MemoryLimit {
-  double bytes = 0;
-  std::string source;
-};
-MemoryLimit memoryLimit();
-
-// Refuses (InputError naming scene.source and particle_spacing) a scene whose particles would need more than
-// 80% of memoryLimit() to simulate, or more than 2^31 of them. Only the simulation asks: surfacing and
-// rendering read frames one at a time, and a render node may have less memory than the simulation needed.
-void checkSimulationMemory(const Scene& scene);
 
 }  // namespace surge

@@ -165,10 +165,15 @@ void visitScene(Scene& s, SceneVisitor& v) {
       [&](size_t i) { visitBody(v, s.bodies[i]); });
 
   v.group("solver", info("the simulator"), [&] {
-    v.choice("method", s.solver.method, {"pbf", "wcsph", "dfsph"},
-             info("pbf: Position Based Fluids (Macklin & Mueller 2013); wcsph: weakly compressible SPH "
-                  "(Monaghan 1994, Becker & Teschner 2007); dfsph: Divergence-Free SPH (Bender & Koschier 2015, "
-                  "2017)"));
+    std::vector<std::string> methods;
+    std::string methodLines;
+    for (const SolverMethodEntry& method : solverMethodCatalog()) {
+      methods.push_back(method.name);
+      methodLines += (methodLines.empty() ? "" : "; ") + method.name + ": " + method.description;
+    }
+    // A program without the simulator (no registry) takes any name, as it takes the simulator's defaults.
+    if (methods.empty()) v.text("method", s.solver.method, info("the fluid method"));
+    else v.choice("method", s.solver.method, methods, info(methodLines.c_str()));
     v.integer("substeps", s.solver.substeps,
               atLeast(0, "PBF: time steps per output frame (WCSPH chooses its own, see time_step; DFSPH takes at "
                          "least this many, from its CFL step); 0: 4, or more if the pool the fluid settles into is "

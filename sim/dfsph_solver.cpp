@@ -300,6 +300,24 @@ FluidMeasures DfsphSolver<Dim>::measure() {
   });
 }
 
+namespace {
+
+// Its solvers move a particle up to about a spacing a step, as PBF's projection does.
+int dfsphPushesPerFrame(const Scene& scene) { return std::max(1, scene.solver.substeps); }
+
+// solver.max_density_error 0 (every other method's "run exactly `iterations`") is 0.0005 for DFSPH.
+void dfsphDefaults(Scene& scene) {
+  if (scene.solver.max_density_error == 0) scene.solver.max_density_error = 0.0005;
+}
+
+}  // namespace
+
+// 800 bytes a particle in 3D, 360 in 2D: a gradient vector and a kernel weight a neighbour pair instead of PBF's
+// factor, and five more floats and a vector a particle (679 bytes measured at 3.3 million particles).
+const FluidMethod kDfsphMethod = {"dfsph", "Divergence-Free SPH (Bender & Koschier 2015, 2017)",
+    &makeMethod<DfsphSolver, 2>, &makeMethod<DfsphSolver, 3>, 360, 800,
+    &dfsphPushesPerFrame, &dfsphDefaults, nullptr};
+
 template class DfsphSolver<2>;
 template class DfsphSolver<3>;
 

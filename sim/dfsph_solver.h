@@ -109,6 +109,9 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   float framePressureMax_ = 0, lastStep_ = 0;
 };
 
+// Its registration (sim/fluid_solver.cpp).
+extern const FluidMethod kDfsphMethod;
+
 extern template class DfsphSolver<2>;
 extern template class DfsphSolver<3>;
 

@@ -3,45 +3,57 @@
 #include "core/errors.h"
 #include "sim/dfsph_solver.h"
 #include "sim/pbf_solver.h"
+#include "sim/solver_defaults.h"
 #include "sim/wcsph_solver.h"
 
 namespace surge {
 namespace {
 
-template <int Dim>
-using MakeSolver = std::unique_ptr<FluidSolver<Dim>> (*)(const Scene&, std::shared_ptr<const ColliderShapes>);
-
-template <template <int> class Method, int Dim>
-std::unique_ptr<FluidSolver<Dim>> make(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes) {
-  return std::make_unique<Method<Dim>>(scene, std::move(shapes));
+// The registry: one line a method.
+std::vector<FluidMethod>& registry() {
+  static std::vector<FluidMethod> methods = {
+      kPbfMethod,
+      kWcsphMethod,
+      kDfsphMethod,
+  };
+  return methods;
 }
 
-template <int Dim>
-struct Registration {
-  const char* method;
-  MakeSolver<Dim> make;
-};
-
-// The registry: one line a method.
-template <int Dim>
-const Registration<Dim> kMethods[] = {
-    {"pbf", &make<PbfSolver, Dim>},
-    {"wcsph", &make<WcsphSolver, Dim>},
-    {"dfsph", &make<DfsphSolver, Dim>},
-};
+// The scene reader learns the methods' names and resolves their defaults wherever the simulator is linked
+// (core/scene.h).
+bool installInSceneReader() {
+  solverDefaults() = &resolveSolverDefaults;
+  for (const FluidMethod& method : registry()) solverMethodCatalog().push_back({method.name, method.description});
+  return true;
+}
+[[maybe_unused]] const bool kInstalled = installInSceneReader();
 
 }  // namespace
 
+const FluidMethod& fluidMethod(const std::string& name, const std::string& source) {
+  for (const FluidMethod& method : registry())
+    if (name == method.name) return method;
+  throw InputError(source, "solver.method", "no solver is registered as \"" + name + "\"");
+}
+
+void registerFluidMethod(const FluidMethod& method) {
+  for (const FluidMethod& known : registry())
+    if (std::string(known.name) == method.name)
+      throw std::logic_error(std::string("registerFluidMethod: \"") + method.name + "\" is registered already");
+  registry().push_back(method);
+  solverMethodCatalog().push_back({method.name, method.description});
+}
+
 template <int Dim>
 std::unique_ptr<FluidSolver<Dim>> makeFluidSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes) {
-  for (const Registration<Dim>& registration : kMethods<Dim>)
-    if (scene.solver.method == registration.method) return registration.make(scene, std::move(shapes));
-  throw InputError(scene.source, "solver.method", "no solver is registered as \"" + scene.solver.method + "\"");
+  const FluidMethod& method = fluidMethod(scene.solver.method, scene.source);
+  if constexpr (Dim == 2) return method.make2(scene, std::move(shapes));
+  else return method.make3(scene, std::move(shapes));
 }
 
 std::vector<std::string> fluidSolverMethods() {
   std::vector<std::string> methods;
-  for (const Registration<3>& registration : kMethods<3>) methods.push_back(registration.method);
+  for (const FluidMethod& method : registry()) methods.push_back(method.name);
   return methods;
 }
 

@@ -1,9 +1,11 @@
 // The one interface every fluid method implements, and the registry that makes the scene's method.
 //
 // The frame loop (sim/simulation.cpp), the rigid bodies' coupling (sim/rigid_bodies.h) and the benchmarks see a
-// solver only through FluidSolver<Dim>. A method is a pair of files (its class deriving from FluidSolver) and one
-// line in the registry (sim/fluid_solver.cpp); its scene keys are declared with the others in
-// core/scene_fields.cpp, and `solver.method`'s choices there must match fluidSolverMethods() (a test checks).
+// solver only through FluidSolver<Dim>. A method is a pair of files (its class deriving from ParticleSolver,
+// sim/particle_solver.h, and its FluidMethod) and one line in the registry (sim/fluid_solver.cpp), or one call
+// of registerFluidMethod for a method outside the library. What the rest of Surge knows of a method it learns
+// from its FluidMethod, never by comparing its name. Its scene keys are declared with the others in
+// core/scene_fields.cpp; `solver.method`'s choices there are the registry's (core/scene.h, solverMethodCatalog).
 // A method allocates only what its scene turns on, so a scene pays only for what its method uses.
 #pragma once
 
@@ -62,6 +64,33 @@ class FluidSolver {
   // Each collider's mean force and torque from the fluid since the last call, over `duration` seconds.
   std::vector<Wrench> takeColliderWrenches(double duration) { return colliders().takeFrameWrenches(duration); }
 };
+
+// A method as the registry holds it: how to make it and what it asks of a scene.
+struct FluidMethod {
+  const char* name;
+  const char* description;  // its paper, for `surge keys`
+  std::unique_ptr<FluidSolver<2>> (*make2)(const Scene&, std::shared_ptr<const ColliderShapes>);
+  std::unique_ptr<FluidSolver<3>> (*make3)(const Scene&, std::shared_ptr<const ColliderShapes>);
+  // Bytes a particle needs at peak, in 2D and 3D, for the memory check (sim/solver_defaults.h).
+  size_t bytesPerParticle2d, bytesPerParticle3d;
+  // How many times a frame the method's own push can move a particle by a spacing (the runaway speed).
+  int (*pushesPerFrame)(const Scene&);
+  // Fills the method's own settings that the file left 0, after the shared ones; null for none.
+  void (*resolveDefaults)(Scene&);
+  // The notes `surge sim` prints before it starts (a setting the scene may regret); null for none.
+  std::vector<std::string> (*notes)(const Scene&);
+};
+
+// FluidMethod::make2 and make3 for a solver class template.
+template <template <int> class Method, int Dim>
+std::unique_ptr<FluidSolver<Dim>> makeMethod(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes) {
+  return std::make_unique<Method<Dim>>(scene, std::move(shapes));
+}
+
+// The method registered as `name`; InputError naming `source` and solver.method if there is none.
+const FluidMethod& fluidMethod(const std::string& name, const std::string& source = "scene");
+// Adds a method to the registry (a method outside the library: a test's, a plug-in's).
+void registerFluidMethod(const FluidMethod& method);
 
 // The solver of scene.solver.method. `shapes`: the scene's collider shapes, built once by the caller (null
 // builds them). InputError if the method is not registered.

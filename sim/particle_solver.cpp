@@ -1,5 +1,7 @@
 #include "sim/particle_solver.h"
 
+#include "sim/solver_defaults.h"
+
 namespace surge {
 
 template <int Dim>

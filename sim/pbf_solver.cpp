@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "core/parallel.h"
+#include "sim/solver_defaults.h"
 #include "sim/tank.h"
 
 namespace surge {
@@ -553,6 +554,28 @@ size_t PbfSolver<Dim>::memoryBytes() const {
   bytes += (found_.capacity() + scratchFound_.capacity()) * sizeof(typename Colliders<Dim>::Found);
   return bytes + this->coreMemoryBytes();
 }
+
+namespace {
+
+// The projection moves a particle up to about a spacing a step (the velocity is that move over the step).
+int pbfPushesPerFrame(const Scene& scene) { return std::max(1, scene.solver.substeps); }
+
+std::vector<std::string> pbfNotes(const Scene& scene) {
+  const int stable = stableSubsteps(scene);
+  if (stable <= scene.solver.substeps) return {};
+  return {"solver.substeps " + std::to_string(scene.solver.substeps) + " is below the " + std::to_string(stable) +
+          " a PBF pool this deep needs to stay at rest (dt <= 0.9 particle_spacing / sqrt(g depth)); leave it out "
+          "to get them"};
+}
+
+}  // namespace
+
+// 400 bytes a particle in 3D: about 340 of channels (x, v, x* and a scratch copy, ids, lambdas, the grid's) and
+// 30 neighbours with their gradient factors, the frame being written, and the allocator's slack; 250 in 2D
+// (docs/performance.md).
+const FluidMethod kPbfMethod = {"pbf", "Position Based Fluids (Macklin & Mueller 2013)",
+    &makeMethod<PbfSolver, 2>, &makeMethod<PbfSolver, 3>, 250, 400,
+    &pbfPushesPerFrame, nullptr, &pbfNotes};
 
 template class PbfSolver<2>;
 template class PbfSolver<3>;

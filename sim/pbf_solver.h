@@ -119,6 +119,9 @@ class PbfSolver final : public ParticleSolver<Dim> {
   int lastIterations_ = 0;
 };
 
+// Its registration (sim/fluid_solver.cpp).
+extern const FluidMethod kPbfMethod;
+
 extern template class PbfSolver<2>;
 extern template class PbfSolver<3>;
 

@@ -16,6 +16,7 @@
 #include "geometry/pose.h"
 #include "sim/fluid_solver.h"
 #include "sim/rigid_bodies.h"
+#include "sim/solver_defaults.h"
 
 namespace surge {
 namespace {

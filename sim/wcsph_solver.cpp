@@ -219,6 +219,19 @@ FluidMeasures WcsphSolver<Dim>::measure() {
   });
 }
 
+namespace {
+
+// The pressure only turns the energy of compression, which the fall gave, back into motion: a spacing a frame, so
+// that a scene with nothing moving (no gravity) still has a runaway speed above zero.
+int wcsphPushesPerFrame(const Scene&) { return 1; }
+
+}  // namespace
+
+// Less than PBF's 400 and 250 bytes a particle (no stored pair factors), counted as those.
+const FluidMethod kWcsphMethod = {"wcsph", "weakly compressible SPH (Monaghan 1994, Becker & Teschner 2007)",
+    &makeMethod<WcsphSolver, 2>, &makeMethod<WcsphSolver, 3>, 250, 400,
+    &wcsphPushesPerFrame, nullptr, nullptr};
+
 template class WcsphSolver<2>;
 template class WcsphSolver<3>;
 

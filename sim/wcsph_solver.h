@@ -78,6 +78,9 @@ class WcsphSolver final : public ParticleSolver<Dim> {
   float framePressureMax_ = 0;
 };
 
+// Its registration (sim/fluid_solver.cpp).
+extern const FluidMethod kWcsphMethod;
+
 extern template class WcsphSolver<2>;
 extern template class WcsphSolver<3>;
 

@@ -33,6 +33,7 @@
 #include "core/scene.h"
 #include "geometry/collider_shape.h"
 #include "geometry/pose.h"
+#include "sim/solver_defaults.h"
 
 extern char** environ;
 

@@ -1,0 +1,97 @@
+#include "sim/solver_defaults.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.h"
+#include "core/process.h"
+#include "sim/fluid_solver.h"
+
+namespace surge {
+
+int stableSubsteps(const Scene& scene) {
+  const int d = scene.dimensions;
+  const Eigen::VectorXd gravity = scene.gravity.head(d);
+  const double g = gravity.norm();
+  if (!(g > 0)) return 1;
+  // The depth of the pool the fluid settles into: its volume over the tank's floor, the floor being the tank's
+  // section across the axis gravity is mostly along.
+  int down = 0;
+  gravity.cwiseAbs().maxCoeff(&down);
+  double floor = 1, volume = 0;
+  for (int k = 0; k < d; ++k)
+    if (k != down) floor *= scene.domain.max[k] - scene.domain.min[k];
+  for (const FluidBlock& fluid : scene.fluids) volume += (fluid.box.max - fluid.box.min).head(d).prod();
+  const double depth = std::min(volume / floor, scene.domain.max[down] - scene.domain.min[down]);
+  if (!(depth > 0)) return 1;
+  const double longest = 0.9 * scene.particle_spacing / std::sqrt(g * depth);
+  const double steps = std::ceil(1.0 / (scene.output.fps * longest) - 1e-9);
+  return int(std::min(steps, 100000.0));
+}
+
+void resolveSolverDefaults(Scene& scene) {
+  SolverSettings& solver = scene.solver;
+  if (solver.substeps == 0) solver.substeps = std::max(4, stableSubsteps(scene));
+  if (solver.speed_of_sound == 0) {
+    // Ten times the fastest the water can move by falling through the tank (or by its initial velocity):
+    // density then varies by about 1% (Monaghan 1994).
+    double speed = std::sqrt(2 * scene.gravity.norm() * (scene.domain.max - scene.domain.min)[1]);
+    for (const FluidBlock& fluid : scene.fluids) speed = std::max(speed, fluid.velocity.norm());
+    solver.speed_of_sound = 10 * std::max(speed, 1.0);
+  }
+  if (solver.gas_constant == 0) solver.gas_constant = solver.speed_of_sound * solver.speed_of_sound;
+  const FluidMethod& method = fluidMethod(solver.method, scene.source);
+  if (method.resolveDefaults) method.resolveDefaults(scene);
+}
+
+double runawaySpeed(const Scene& scene) {
+  const int d = scene.dimensions;
+  const double diagonal = (scene.domain.max - scene.domain.min).head(d).norm();
+  double fluid = 0, bodies = 0, colliders = 0, attractor = 0;
+  for (const FluidBlock& block : scene.fluids) fluid = std::max(fluid, block.velocity.head(d).norm());
+  for (const BodySettings& body : scene.bodies)
+    bodies = std::max(bodies, body.velocity.head(d).norm() + body.angular_velocity.norm() * diagonal);
+  for (const ColliderSettings& collider : scene.colliders)
+    for (size_t k = 1; k < collider.motion.size(); ++k) {
+      const ColliderKeyframe &a = collider.motion[k - 1], &b = collider.motion[k];
+      const double dt = b.time - a.time;
+      if (!(dt > 0)) continue;
+      const double turn = std::abs(b.rotation.degrees - a.rotation.degrees) * M_PI / 180.0 +
+                          (a.rotation.axis != b.rotation.axis ? 2 * M_PI : 0.0);
+      colliders = std::max(colliders, ((b.position - a.position).head(d).norm() + turn * diagonal) / dt);
+    }
+  if (!scene.attractor.keyframes.empty()) {
+    double moving = 0;  // the attractor's fastest keyframed speed
+    for (size_t k = 1; k < scene.attractor.keyframes.size(); ++k) {
+      const AttractorKeyframe &a = scene.attractor.keyframes[k - 1], &b = scene.attractor.keyframes[k];
+      if (b.time > a.time) moving = std::max(moving, (b.position - a.position).head(d).norm() / (b.time - a.time));
+    }
+    attractor = std::sqrt(std::abs(scene.attractor.strength) * scene.attractor.radius) + moving;
+  }
+  const double fall = std::sqrt(2 * scene.gravity.head(d).norm() * diagonal);
+  const double solver = scene.particle_spacing * scene.output.fps *
+                        fluidMethod(scene.solver.method, scene.source).pushesPerFrame(scene);
+  return 10 * (fluid + bodies + 2 * colliders + attractor + fall + solver);
+}
+
+size_t bytesPerParticleEstimate(int dimensions, const std::string& method) {
+  const FluidMethod& m = fluidMethod(method);
+  return dimensions == 3 ? m.bytesPerParticle3d : m.bytesPerParticle2d;
+}
+
+void checkSimulationMemory(const Scene& scene) {
+  const size_t count = scene.particleCount();
+  const double bytes = double(count) * double(bytesPerParticleEstimate(scene.dimensions, scene.solver.method));
+  const MemoryLimit memory = memoryLimit();
+  if (count > (size_t(1) << 31) || bytes > 0.8 * memory.bytes)
+    throw InputError(scene.source, "particle_spacing",
+                     std::to_string(count) + " particles need about " + formatBytes(bytes) + " to simulate, more than " +
+                         memory.source + " " + formatBytes(memory.bytes) + " allow (80%)");
+}
+
+std::vector<std::string> solverNotes(const Scene& scene) {
+  const FluidMethod& method = fluidMethod(scene.solver.method, scene.source);
+  return method.notes ? method.notes(scene) : std::vector<std::string>{};
+}
+
+}  // namespace surge

@@ -1,0 +1,44 @@
+// What a scene's physics asks of the simulator, decided once here for every method from the registrations
+// (sim/fluid_solver.h): the defaults the file left 0, the speed that marks a particle as run away, the memory a
+// run needs, and the notes `surge sim` prints before it starts.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/scene.h"
+
+namespace surge {
+
+// The fewest steps a frame with which a PBF column of fluid stays at rest: dt <= 0.9 spacing / sqrt(|g| H), H the
+// depth of the pool the fluid settles into (its volume over the tank's floor). Each step gravity moves every
+// particle by g dt^2, and a column of H / spacing layers sags by g dt^2 H / spacing before the iterations push it
+// back; near a spacing the layers pass through each other and the pool boils (docs/speed-accuracy.md).
+int stableSubsteps(const Scene& scene);
+
+// Fills the solver keys the file left 0 (SolverDefaults, core/scene.h): solver.substeps to max(4,
+// stableSubsteps), speed_of_sound to ten times the fastest the water can move by falling through the tank,
+// gas_constant to its square, and then the scene's method's own (FluidMethod::resolveDefaults).
+void resolveSolverDefaults(Scene& scene);
+
+// The speed that marks a particle as run away (a diverged solver): ten times the fastest the scene can give a
+// particle, which is the sum of its initial speeds (fluid, bodies, with their spin over the tank's diagonal),
+// twice the fastest collider (a wall moving at V throws what it meets at up to 2 V), the attractor's pull
+// (sqrt(strength radius), the speed of a fall into it) and its own speed, a free fall across the tank's diagonal
+// (sqrt(2 g L)), and the method's own push (a spacing each of FluidMethod::pushesPerFrame). Stable runs stay
+// well under a tenth of it; a blow-up passes it within a few steps.
+double runawaySpeed(const Scene& scene);
+
+// Bytes the scene's method needs per particle at peak (FluidMethod::bytesPerParticle).
+size_t bytesPerParticleEstimate(int dimensions, const std::string& method);
+
+// Refuses (InputError naming scene.source and particle_spacing) a scene whose particles would need more than
+// 80% of memoryLimit() (core/process.h) to simulate, or more than 2^31 of them. Only the simulation asks:
+// surfacing and rendering read frames one at a time, and a render node may have less memory than the
+// simulation needed.
+void checkSimulationMemory(const Scene& scene);
+
+// The lines `surge sim` prints before it starts about the scene's settings (its method's), or none.
+std::vector<std::string> solverNotes(const Scene& scene);
+
+}  // namespace surge

@@ -1,0 +1,90 @@
+// What the simulator decides from a scene's physics and its method's registration (sim/solver_defaults.h).
+#include "sim/solver_defaults.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+#include "core/errors.h"
+#include "core/process.h"
+#include "sim/fluid_solver.h"
+
+namespace surge {
+namespace {
+
+const char* kValid = R"({
+  "name": "tiny", "dimensions": 3,
+  "domain": {"min": [0, 0, 0], "max": [1, 1, 0.5]},
+  "particle_spacing": 0.05,
+  "fluids": [{"box": {"min": [0, 0, 0], "max": [0.4, 0.5, 0.5]}, "velocity": [1, 0, 0]}],
+  "solver": {"substeps": 2},
+  "output": {"fps": 24, "frames": 3}
+})";
+
+// Only the simulation refuses a scene by the memory its particles need (surface and render read any folder),
+// and by the least of the machine's memory, its cgroup's limit and a Slurm job's.
+TEST(SolverDefaults, MemoryCheckIsTheSimulationsAndHonoursTheJobsLimit) {
+  // A lattice of 1e-5 m in a 0.4 x 0.5 x 0.5 box: 1e13 particles, far beyond any memory; the scene still loads.
+  const Scene huge = parseScene(kValid, "scene.json", {"particle_spacing=1e-5"});
+  try {
+    checkSimulationMemory(huge);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("scene.json: particle_spacing: ", 0), 0u) << e.what();
+  }
+  const Scene scene = parseScene(kValid, "scene.json", {"particle_spacing=0.01"});
+  const double need = double(scene.particleCount()) * bytesPerParticleEstimate(3, "pbf");
+  ASSERT_LT(need, 0.8 * memoryLimit().bytes);
+  EXPECT_NO_THROW(checkSimulationMemory(scene));
+  // A Slurm job that asked for less than 1.25 times the need: refused, naming the job's limit.
+  const std::string megabytes = std::to_string(int(need / 0.8 / 1048576.0 * 0.9));
+  ::setenv("SLURM_MEM_PER_NODE", megabytes.c_str(), 1);
+  EXPECT_EQ(memoryLimit().source, "this Slurm job's");
+  EXPECT_NEAR(memoryLimit().bytes, std::stod(megabytes) * 1048576.0, 1.0);
+  try {
+    checkSimulationMemory(scene);
+    ADD_FAILURE() << "a job limit of " << megabytes << " MB was not enough for " << need << " bytes";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("more than this Slurm job's"), std::string::npos) << e.what();
+  }
+  ::unsetenv("SLURM_MEM_PER_NODE");
+  EXPECT_NO_THROW(checkSimulationMemory(scene));
+}
+
+// Each method's registration, not a comparison of names, decides its defaults and its memory: DFSPH's density
+// limit of 0 is 0.0005 and PBF's stays 0 (run exactly `iterations`); DFSPH's pairs hold a gradient vector each.
+TEST(SolverDefaults, EachMethodsRegistrationResolvesItsOwnDefaults) {
+  EXPECT_DOUBLE_EQ(parseScene(kValid, "s", {"solver.method=dfsph"}).solver.max_density_error, 0.0005);
+  EXPECT_DOUBLE_EQ(parseScene(kValid, "s", {"solver.method=pbf"}).solver.max_density_error, 0.0);
+  EXPECT_DOUBLE_EQ(parseScene(kValid, "s", {"solver.method=dfsph", "solver.max_density_error=0.01"})
+                       .solver.max_density_error, 0.01);
+  EXPECT_GT(bytesPerParticleEstimate(3, "dfsph"), bytesPerParticleEstimate(3, "pbf"));
+  // WCSPH's push is a spacing a frame, PBF's a spacing a step: PBF's runaway speed is the larger by 10 x spacing x
+  // fps x (substeps - 1), everything else being the scene's.
+  const Scene pbf = parseScene(kValid, "s", {"solver.method=pbf", "solver.substeps=5"});
+  const Scene wcsph = parseScene(kValid, "s", {"solver.method=wcsph", "solver.substeps=5"});
+  EXPECT_NEAR(runawaySpeed(pbf) - runawaySpeed(wcsph), 10 * 0.05 * 24 * 4, 1e-9);
+  // PBF's note about substeps below the stable number, and none when they meet it.
+  EXPECT_EQ(solverNotes(parseScene(kValid, "s", {"solver.substeps=1", "particle_spacing=0.005"})).size(), 1u);
+  EXPECT_TRUE(solverNotes(parseScene(kValid, "s")).empty());
+  EXPECT_TRUE(solverNotes(parseScene(kValid, "s", {"solver.method=wcsph", "solver.substeps=1"})).empty());
+  // A name the registry does not hold is refused as the scene is read.
+  try {
+    parseScene(kValid, "s", {"solver.method=sph"});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("solver.method: 'sph' is not one of: pbf, wcsph, dfsph"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(SolverDefaults, DocumentationListsEveryKey) {
+  // docs/scene-format.md embeds the table that `surge keys` prints; a key added to scene_fields.cpp without
+  // regenerating the document fails here. Here, where the simulator's registry names solver.method's choices.
+  const std::string doc = readTextFile(fs::path(SURGE_SOURCE_DIR) / "docs" / "scene-format.md");
+  const std::string table = sceneKeysMarkdown();
+  EXPECT_NE(doc.find(table), std::string::npos) << "regenerate the table with `surge keys`";
+}
+
+}  // namespace
+}  // namespace surge
