@@ -1,4 +1,5 @@
-// Binary little-endian PLY, the format of Surge's particle frames and surface meshes.
+// PLY files, the format of Surge's particle frames and meshes: written binary little-endian, read in ASCII or
+// binary of either byte order.
 // Particle frames (DESIGN.md): one `vertex` element with float x y z vx vy vz and uint id; a frame holds
 // everything needed to continue a simulation from it. Meshes: vertex x y z nx ny nz and a `face` element with a
 // `vertex_indices` list, as Blender and Houdini read them. Writes are atomic (see writeFileAtomically).
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "core/files.h"
+#include "core/mesh.h"
 
 namespace surge {
 
@@ -26,12 +28,6 @@ struct ParticleFrame {
     velocity.resize(n);
     id.resize(n);
   }
-};
-
-struct TriangleMesh {
-  std::vector<Eigen::Vector3f> positions;
-  std::vector<Eigen::Vector3f> normals;  // one per vertex, or empty
-  std::vector<std::array<uint32_t, 3>> triangles;
 };
 
 void writeParticlePly(const fs::path& path, const ParticleFrame& frame);

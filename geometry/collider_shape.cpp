@@ -2,11 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 #include "core/errors.h"
 #include "geometry/pose.h"
-#include "geometry/shape_files.h"
+#include "geometry/shapes.h"
 
 namespace surge {
 namespace {
@@ -126,19 +125,6 @@ size_t ColliderShape::memoryBytes() const {
          mesh.positions.capacity() * sizeof(Vec3) * 2 + mesh.triangles.capacity() * 12;
 }
 
-bool isClosedManifold(const TriangleMesh& mesh) {
-  std::map<std::pair<uint32_t, uint32_t>, int> edges;
-  for (const auto& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t a = t[k], b = t[(k + 1) % 3];
-      ++edges[{std::min(a, b), std::max(a, b)}];
-    }
-  if (edges.empty()) return false;
-  for (const auto& [edge, count] : edges)
-    if (count != 2) return false;
-  return true;
-}
-
 ColliderShape buildColliderShape(const Scene& scene, size_t index) {
   return buildSolidShape(scene, scene.colliders.at(index), "colliders[" + std::to_string(index) + "]", false);
 }
@@ -153,86 +139,16 @@ ColliderShape buildSolidShape(const Scene& scene, const ColliderSettings& c, con
   const float support = float(scene.solver.kernel_radius > 0 ? scene.solver.kernel_radius : 2 * spacing);
   const Vec3 domainExtent = (scene.domain.max - scene.domain.min).cast<float>();
   const float domainSize = domainExtent.norm();
+  const ShapeType* type = findShapeType(c.shape);
+  if (!type) throw InputError(where, key + ".shape", "unknown shape '" + c.shape + "'");
+  if (!body && !type->collider) throw InputError(where, key + ".shape", "a " + c.shape + " cannot be a collider");
+  if (body && !type->body) throw InputError(where, key + ".shape", "a " + c.shape + " cannot be a body");
+  if (body && scene.dimensions == 2 && !type->body2d)
+    throw InputError(where, key + ".shape", "a " + c.shape + " body needs 3 dimensions");
   ColliderShape s;
+  s.kind = type->kind;
   s.container = c.container != 0;
-  if (c.shape == "plane") {
-    s.kind = ShapeKind::Plane;
-    s.planeNormal = c.normal.cast<float>().normalized();
-    // Drawn as a square four times the domain's size across, about the point.
-    const Vec3 n = s.planeNormal;
-    const Vec3 a = (std::abs(n.x()) < 0.9f ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
-    const Vec3 b = n.cross(a);
-    const float half = 2 * domainSize;
-    s.mesh.positions = {-half * a - half * b, half * a - half * b, half * a + half * b, -half * a + half * b};
-    s.mesh.normals.assign(4, n);
-    s.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
-    s.bounds = Eigen::AlignedBox3f(Vec3::Constant(-half), Vec3::Constant(half));
-  } else if (c.shape == "box") {
-    s.kind = ShapeKind::Box;
-    Eigen::Vector3d size = Eigen::Vector3d::Zero();
-    for (size_t k = 0; k < c.size.size(); ++k) size[k] = c.size[k];
-    // In 2D a box is a prism through the plane, deep enough to draw.
-    if (scene.dimensions == 2) size.z() = std::max(size.x(), size.y());
-    s.halfExtents = (0.5 * size).cast<float>();
-    s.mesh = boxMesh(s.halfExtents);
-  } else if (c.shape == "sphere") {
-    s.kind = ShapeKind::Sphere;
-    s.radius = float(c.radius);
-    s.mesh = sphereMesh(s.radius);
-  } else if (c.shape == "capsule") {
-    s.kind = ShapeKind::Capsule;
-    s.radius = float(c.radius);
-    s.halfHeight = float(0.5 * c.height);
-    s.mesh = capsuleMesh(s.radius, s.halfHeight);
-  } else if (c.shape == "cylinder") {
-    s.kind = ShapeKind::Cylinder;
-    s.radius = float(c.radius);
-    s.halfHeight = float(0.5 * c.height);
-    s.mesh = cylinderMesh(s.radius, s.halfHeight);
-  } else if (c.shape == "heightfield") {
-    s.kind = ShapeKind::Heightfield;
-    s.heightfield = readHeightfieldPng(c.file, float(c.size[0]), float(c.size[1]), float(c.height), where,
-                                       key + ".file");
-    // The solid reaches a domain's size below its lowest point (the fluid stays above it everywhere).
-    s.mesh = heightfieldMesh(s.heightfield, s.heightfield.minHeight() - domainSize, spacing / float(c.scale));
-  } else {
-    s.kind = ShapeKind::Mesh;
-    s.mesh = readMeshFile(c.file, where, key + ".file");
-    if (s.mesh.triangles.empty()) throw InputError(where, key + ".file", "'" + c.file + "' has no triangles");
-    for (const Vec3& p : s.mesh.positions)
-      if (!p.allFinite()) throw InputError(where, key + ".file", "'" + c.file + "' has a vertex that is not finite");
-    // The grid's voxel is half a particle spacing in the world, the band covers the kernel and a spacing more.
-    const float scale = float(c.scale);
-    const float voxel = 0.5f * spacing / scale, band = (support + 2 * spacing) / scale;
-    const bool closed = isClosedManifold(s.mesh);
-    const float shell = closed ? 0.0f : float(c.thickness) / scale;
-    Eigen::AlignedBox3f box;
-    for (const Vec3& p : s.mesh.positions) box.extend(p);
-    const Eigen::Array3f cells = ((box.sizes().array() + 2 * band + shell) / voxel).ceil() + 1;
-    const double bytes = 4.0 * cells.cast<double>().prod();
-    if (bytes > 2e9)
-      throw InputError(where, key + ".file",
-                       "the mesh's distance grid would need " + std::to_string(int(bytes / 1e9)) +
-                           " GB at a voxel of half particle_spacing; scale the mesh down or coarsen the spacing");
-    if (!closed && body)
-      throw InputError(where, key + ".file",
-                       "'" + c.file + "' is open or non-manifold: a body needs a closed mesh for its volume");
-    if (!closed) {
-      char line[256];
-      std::snprintf(line, sizeof line, "is open or non-manifold: treated as a shell %.4g m thick", c.thickness);
-      s.note = key + " (" + fs::path(c.file).filename().string() + ") " + line;
-      if (s.container) throw InputError(where, key + ".container", "an open mesh cannot hold fluid");
-    }
-    s.grid = bakeMeshDistance(s.mesh, voxel, band, shell);
-  }
-  if (s.kind == ShapeKind::Heightfield) {
-    const Heightfield& h = s.heightfield;
-    s.bounds = Eigen::AlignedBox3f(Vec3(-0.5f * h.sizeX, h.minHeight() - domainSize, -0.5f * h.sizeZ),
-                                   Vec3(0.5f * h.sizeX, h.maxHeight(), 0.5f * h.sizeZ));
-  } else if (s.kind != ShapeKind::Plane) {
-    s.bounds = Eigen::AlignedBox3f();
-    for (const Vec3& p : s.mesh.positions) s.bounds.extend(p);
-  }
+  type->build(s, ShapeInput{scene, c, key, where, body, spacing, support, domainSize});
   if (s.container)
     for (Vec3& n : s.mesh.normals) n = -n;
 

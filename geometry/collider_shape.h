@@ -11,10 +11,13 @@
 #include "core/ply.h"
 #include "core/scene.h"
 #include "geometry/distance_grid.h"
+#include "geometry/triangle_mesh.h"
 
 namespace surge {
 
+// Every kind has its entry in geometry/shapes.h (its name, builder, mass); keep Mesh last.
 enum class ShapeKind { Plane, Box, Sphere, Capsule, Cylinder, Heightfield, Mesh };
+constexpr size_t kShapeKinds = size_t(ShapeKind::Mesh) + 1;
 
 // Heights from a greyscale image over [-size_x / 2, size_x / 2] x [-size_z / 2, size_z / 2]: pixel (0, 0) at
 // (-x, -z), black at 0, white at `height`; bilinear between pixel centres, held beyond the edges.
@@ -63,12 +66,10 @@ class ColliderShape {
 ColliderShape buildColliderShape(const Scene& scene, size_t index);
 // Body `index` likewise; a body's mesh must be closed, and the body must start inside the domain.
 ColliderShape buildBodyShape(const Scene& scene, size_t index);
-// Either, from its settings; `key` ("colliders[2]") names it in errors.
+// Either, from its settings; `key` ("colliders[2]") names it in errors, `key`.shape a shape that the part
+// does not take (a plane body, a mesh body in 2D, a name not in geometry/shapes.h).
 ColliderShape buildSolidShape(const Scene& scene, const ColliderSettings& settings, const std::string& key,
                               bool body);
-
-// True if every edge of the mesh is shared by exactly two triangles (a closed, manifold surface).
-bool isClosedManifold(const TriangleMesh& mesh);
 
 // A mesh's signed distance on a grid of `voxel` covering its box plus `band` on every side (geometry/mesh_sdf.cpp,
 // OpenVDB's mesh to volume). A closed mesh gets its true inside; an open one (shellThickness > 0) becomes a shell

@@ -1,7 +1,7 @@
-// Mass, centre of mass and inertia tensor of a solid shape at a density: closed forms for the analytic shapes,
-// the volume integrals of a closed triangle mesh (the divergence theorem over signed tetrahedra) for a mesh. In
-// 2D a shape is its cross-section in the plane z = 0, the density is per area and the mass per metre of depth;
-// only the inertia about z counts there.
+// Mass, centre of mass and inertia tensor of a solid shape at a density: closed forms for the analytic shapes
+// (their entries in geometry/shapes.cpp), the volume integrals of a closed triangle mesh (the divergence
+// theorem over signed tetrahedra) for a mesh. In 2D a shape is its cross-section in the plane z = 0, the density
+// is per area and the mass per metre of depth; only the inertia about z counts there.
 #pragma once
 
 #include <Eigen/Core>

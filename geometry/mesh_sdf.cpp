@@ -1,6 +1,7 @@
-// The mesh's signed distance, baked with OpenVDB's mesh to volume (the only OpenVDB in geometry/), then copied
-// into a dense DistanceGrid that the simulator reads without OpenVDB.
-#include <openvdb/openvdb.h>
+// A mesh's level set by OpenVDB's mesh to volume (the only OpenVDB in geometry/), and the simulator's mesh
+// distance: that level set copied into a dense DistanceGrid, which the simulator reads without OpenVDB.
+#include "geometry/mesh_sdf.h"
+
 #include <openvdb/tools/Dense.h>
 #include <openvdb/tools/MeshToVolume.h>
 
@@ -10,29 +11,32 @@
 
 namespace surge {
 
-DistanceGrid bakeMeshDistance(const TriangleMesh& mesh, float voxel, float band, float shellThickness) {
-  openvdb::initialize();
+openvdb::FloatGrid::Ptr meshLevelSet(const TriangleMesh& mesh, const openvdb::math::Transform& transform,
+                                     float exterior, float interior, bool unsignedDistance,
+                                     openvdb::Int32Grid* nearest) {
+  // Points in index space, as OpenVDB's own meshToSignedDistanceField makes them.
   std::vector<openvdb::Vec3s> points;
   points.reserve(mesh.positions.size());
-  Eigen::AlignedBox3f box;
-  for (const Eigen::Vector3f& p : mesh.positions) {
-    points.emplace_back(p.x(), p.y(), p.z());
-    box.extend(p);
-  }
+  for (const Eigen::Vector3f& p : mesh.positions)
+    points.emplace_back(transform.worldToIndex(openvdb::Vec3d(p.x(), p.y(), p.z())));
   std::vector<openvdb::Vec3I> triangles;
   triangles.reserve(mesh.triangles.size());
   for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-  const std::vector<openvdb::Vec4I> quads;
+  const openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(points, triangles);
+  return openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+      adapter, transform, exterior, interior, unsignedDistance ? openvdb::tools::UNSIGNED_DISTANCE_FIELD : 0,
+      nearest);
+}
+
+DistanceGrid bakeMeshDistance(const TriangleMesh& mesh, float voxel, float band, float shellThickness) {
+  openvdb::initialize();
+  Eigen::AlignedBox3f box;
+  for (const Eigen::Vector3f& p : mesh.positions) box.extend(p);
   const auto transform = openvdb::math::Transform::createLinearTransform(voxel);
   const float reach = band + 0.5f * shellThickness;
   const float bandVoxels = std::ceil(reach / voxel) + 2;
-  openvdb::FloatGrid::Ptr grid;
-  if (shellThickness > 0)
-    grid = openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*transform, points, triangles, quads,
-                                                                           bandVoxels);
-  else
-    grid = openvdb::tools::meshToSignedDistanceField<openvdb::FloatGrid>(*transform, points, triangles, quads,
-                                                                         bandVoxels, bandVoxels);
+  const openvdb::FloatGrid::Ptr grid =
+      meshLevelSet(mesh, *transform, bandVoxels, bandVoxels, /*unsignedDistance=*/shellThickness > 0);
   // The dense box: the mesh's box plus the band, in whole voxels.
   openvdb::Coord lo, hi;
   for (int a = 0; a < 3; ++a) {

@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "core/errors.h"
+#include "geometry/triangle_mesh.h"
 
 namespace surge {
 namespace {
@@ -137,15 +138,6 @@ TriangleMesh readMeshFile(const std::string& file, const std::string& where, con
   }
   computeVertexNormals(mesh);
   return mesh;
-}
-
-void computeVertexNormals(TriangleMesh& mesh) {
-  mesh.normals.assign(mesh.positions.size(), Vec3::Zero());
-  for (const auto& t : mesh.triangles) {
-    const Vec3 n = (mesh.positions[t[1]] - mesh.positions[t[0]]).cross(mesh.positions[t[2]] - mesh.positions[t[0]]);
-    for (int k = 0; k < 3; ++k) mesh.normals[t[k]] += n;
-  }
-  for (Vec3& n : mesh.normals) n = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::UnitY();
 }
 
 }  // namespace surge

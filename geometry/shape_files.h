@@ -21,7 +21,4 @@ TriangleMesh heightfieldMesh(const Heightfield& heightfield, float bottom, float
 // A triangle mesh from an .obj or .ply file (by extension; polygons are fanned into triangles).
 TriangleMesh readMeshFile(const std::string& file, const std::string& where, const std::string& key);
 
-// Per-vertex normals as area-weighted sums of the faces' normals.
-void computeVertexNormals(TriangleMesh& mesh);
-
 }  // namespace surge

@@ -13,6 +13,7 @@
 
 #include "core/errors.h"
 #include "core/files.h"
+#include "geometry/shapes.h"
 
 namespace surge {
 namespace {
@@ -31,7 +32,44 @@ constexpr double kLongestBulletStep = 1e-3;  // s
 // Bullet's contact margin: a tenth of the particle spacing (Bullet's default of 4 cm is larger than many bodies).
 double contactMargin(const Scene& scene) { return 0.1 * scene.particle_spacing; }
 
+// How Bullet holds each kind: a half-space, its own primitive, the triangles of the drawing mesh (static
+// only), or the mesh's convex hull (a moving body).
+enum class BulletShape { Plane, Primitive, Triangles, Hull };
+
+// A collider of each kind (a container is its triangles, whatever its kind).
+BulletShape colliderShape(ShapeKind kind) {
+  switch (kind) {
+    case ShapeKind::Plane: return BulletShape::Plane;
+    case ShapeKind::Box:
+    case ShapeKind::Sphere:
+    case ShapeKind::Capsule:
+    case ShapeKind::Cylinder: return BulletShape::Primitive;
+    case ShapeKind::Heightfield:
+    case ShapeKind::Mesh: return BulletShape::Triangles;
+  }
+  return BulletShape::Triangles;
+}
+
+// A body of each kind; one that Bullet cannot move (a half-space, a heightfield's open solid) is an InputError
+// naming `key`.shape.
+BulletShape bodyShape(ShapeKind kind, const std::string& where, const std::string& key) {
+  switch (kind) {
+    case ShapeKind::Box:
+    case ShapeKind::Sphere:
+    case ShapeKind::Capsule:
+    case ShapeKind::Cylinder: return BulletShape::Primitive;
+    case ShapeKind::Mesh: return BulletShape::Hull;
+    case ShapeKind::Plane:
+    case ShapeKind::Heightfield: break;
+  }
+  throw InputError(where, key + ".shape", std::string("a ") + shapeType(kind).name + " cannot be a body");
+}
+
 }  // namespace
+
+void checkBodyShape(ShapeKind kind, const std::string& where, const std::string& key) {
+  bodyShape(kind, where, key);
+}
 
 // Bullet's objects. Shapes live as long as RigidBodies; the world and its objects are rebuilt every frame.
 struct RigidBodies::World {
@@ -58,15 +96,19 @@ struct RigidBodies::World {
     shapes.emplace_back(shape);
     return shape;
   }
-  // A box, sphere, capsule or cylinder (along y) as Bullet's own shape, scaled.
+  // A box, sphere, capsule or cylinder (along y) as Bullet's own shape, scaled; null for the other kinds.
   btCollisionShape* primitive(const ColliderShape& shape, double scale, double margin) {
     const double r = scale * shape.radius, h = scale * shape.halfHeight;
     switch (shape.kind) {
       case ShapeKind::Box: return keep(new btBoxShape(toBullet(scale * shape.halfExtents.cast<double>())), margin);
       case ShapeKind::Sphere: return keep(new btSphereShape(r), margin);
       case ShapeKind::Capsule: return keep(new btCapsuleShape(r, 2 * h), margin);
-      default: return keep(new btCylinderShape(btVector3(r, h, r)), margin);
+      case ShapeKind::Cylinder: return keep(new btCylinderShape(btVector3(r, h, r)), margin);
+      case ShapeKind::Plane:
+      case ShapeKind::Heightfield:
+      case ShapeKind::Mesh: return nullptr;
     }
+    return nullptr;
   }
   btCollisionShape* triangleMesh(const TriangleMesh& mesh, double scale, double margin) {
     auto soup = std::make_unique<btTriangleMesh>();
@@ -103,6 +145,7 @@ RigidBodies::RigidBodies(const Scene& scene, std::shared_ptr<const ColliderShape
   if (scene.bodies.empty()) return;
   if (!shapes_) shapes_ = buildColliderShapes(scene);
   const double margin = contactMargin(scene);
+  const std::string where = scene.source.empty() ? "scene" : scene.source;
   World& w = *world_;
   const size_t first = scene.colliders.size();
   // The tank: a slab beyond each wall, as thick as the domain is wide.
@@ -126,12 +169,17 @@ RigidBodies::RigidBodies(const Scene& scene, std::shared_ptr<const ColliderShape
     const ColliderShape& shape = (*shapes_)[c];
     const double scale = scene.colliders[c].scale;
     btCollisionShape* s = nullptr;
-    if (shape.kind == ShapeKind::Plane) {
-      s = w.keep(new btStaticPlaneShape(toBullet(shape.planeNormal.cast<double>()), 0), margin);
-    } else if (shape.container || shape.kind == ShapeKind::Heightfield || shape.kind == ShapeKind::Mesh) {
-      s = w.triangleMesh(shape.mesh, scale, margin);
-    } else {
-      s = w.primitive(shape, scale, margin);
+    switch (colliderShape(shape.kind)) {
+      case BulletShape::Plane:
+        s = w.keep(new btStaticPlaneShape(toBullet(shape.planeNormal.cast<double>()), 0), margin);
+        break;
+      case BulletShape::Primitive:
+        s = shape.container ? w.triangleMesh(shape.mesh, scale, margin) : w.primitive(shape, scale, margin);
+        break;
+      case BulletShape::Triangles:
+      case BulletShape::Hull:
+        s = w.triangleMesh(shape.mesh, scale, margin);
+        break;
     }
     w.colliderShapes.push_back(s);
   }
@@ -139,6 +187,7 @@ RigidBodies::RigidBodies(const Scene& scene, std::shared_ptr<const ColliderShape
   for (size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodySettings& settings = scene.bodies[b];
     const ColliderShape& shape = (*shapes_)[first + b];
+    const bool asHull = bodyShape(shape.kind, where, "bodies[" + std::to_string(b) + "]") == BulletShape::Hull;
     const double scale = settings.solid.scale;
     MassProperties m = surge::massProperties(shape, scale, scene.dimensions, 1.0);
     const double density = settings.density > 0 ? settings.density : settings.mass / m.volume;
@@ -152,7 +201,7 @@ RigidBodies::RigidBodies(const Scene& scene, std::shared_ptr<const ColliderShape
       m.inertia = eigen.eigenvalues().asDiagonal();
     }
     btCollisionShape* s = nullptr;
-    if (shape.kind != ShapeKind::Mesh) {
+    if (!asHull) {
       s = w.primitive(shape, scale, margin);
     } else {
       // A mesh collides as its convex hull, in the principal frame about the centre of mass.

@@ -94,6 +94,10 @@ long coupledStep(Solver& solver, RigidBodies* bodies, float dt, double time, lon
   return bad;
 }
 
+// Throws InputError naming `key`.shape if Bullet cannot move a body of this kind (sim/rigid_bodies.cpp's
+// table of Bullet shapes; buildBodyShape refuses such a body first, by geometry/shapes.h).
+void checkBodyShape(ShapeKind kind, const std::string& where, const std::string& key);
+
 // The bodies' state at a frame, exactly (hexadecimal floating point): one line a body, "name" then position,
 // orientation (w x y z), velocity, angular velocity, fluid force and torque. Written atomically.
 void writeBodyStates(const fs::path& path, const Scene& scene, const std::vector<BodyState>& states);

@@ -5,20 +5,20 @@
 #include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/Clip.h>
 #include <openvdb/tools/Interpolation.h>
-#include <openvdb/tools/MeshToVolume.h>
 #include <openvdb/tools/Prune.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <optional>
 #include <utility>
 
 #include "core/errors.h"
 #include "core/parallel.h"
 #include "core/ply.h"
+#include "geometry/mesh_sdf.h"
+#include "geometry/triangle_mesh.h"
 
 namespace surge {
 namespace {
@@ -30,16 +30,6 @@ using openvdb::Vec3d;
 using Leaf = FloatGrid::TreeType::LeafNodeType;
 constexpr int kLeafVoxels = int(Leaf::SIZE);
 constexpr int kLeafDim = int(Leaf::DIM);
-
-// Every edge shared by exactly two triangles (geometry/'s isClosedManifold, on the same indices, so the
-// surfacer takes an open mesh for a shell exactly when the simulator did).
-bool isClosed(const TriangleMesh& mesh) {
-  std::map<std::pair<uint32_t, uint32_t>, int> edges;
-  for (const auto& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) ++edges[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
-  if (edges.empty()) return false;
-  return std::all_of(edges.begin(), edges.end(), [](const auto& e) { return e.second == 2; });
-}
 
 // The point of triangle abc nearest to p (Ericson, Real-Time Collision Detection, 5.1.5); not finite for a
 // degenerate triangle.
@@ -203,21 +193,22 @@ SurfaceCollider makeSurfaceCollider(const ColliderSettings& settings, const Tria
     c.offset = n.dot(mesh.positions[mesh.triangles.front()[0]].cast<double>());
     return c;
   }
-  // The level set by tools::meshToVolume from index-space points, with the nearest triangle of every voxel.
+  // The level set by OpenVDB's mesh to volume (geometry/mesh_sdf.h), with the nearest triangle of every voxel;
+  // in 2D the mesh is first cut to the region along z.
   const double voxel = grids.voxel;
   const auto transform = openvdb::math::Transform::createLinearTransform(voxel);
   auto triangles = std::make_shared<ColliderTriangles>();
-  std::vector<openvdb::Vec3s> points;
-  std::vector<openvdb::Vec3I> polygons;
-  for (Eigen::Vector3f p : mesh.positions) {
-    if (grids.flat && !grids.region.isEmpty())
+  TriangleMesh clamped;
+  const bool clampZ = grids.flat && !grids.region.isEmpty();
+  if (clampZ) {
+    clamped = mesh;
+    for (Eigen::Vector3f& p : clamped.positions)
       p.z() = float(std::clamp(double(p.z()), grids.region.min().z(), grids.region.max().z()));
-    triangles->positions.push_back(p.cast<double>());
-    points.emplace_back(transform->worldToIndex(openvdb::Vec3d(p.x(), p.y(), p.z())));
   }
+  const TriangleMesh& placed = clampZ ? clamped : mesh;
+  for (const Eigen::Vector3f& p : placed.positions) triangles->positions.push_back(p.cast<double>());
   const bool hasNormals = mesh.normals.size() == mesh.positions.size();
   for (const auto& t : mesh.triangles) {
-    polygons.emplace_back(t[0], t[1], t[2]);
     triangles->triangles.push_back(t);
     const Eigen::Vector3d& a = triangles->positions[t[0]];
     Eigen::Vector3d n = (triangles->positions[t[1]] - a).cross(triangles->positions[t[2]] - a);
@@ -226,24 +217,22 @@ SurfaceCollider makeSurfaceCollider(const ColliderSettings& settings, const Tria
       n = -n;
     triangles->facing.push_back(n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero());
   }
-  const openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(points, polygons);
   triangles->nearest = openvdb::Int32Grid::create();
   FloatGrid::Ptr grid;
-  if (settings.shape == "mesh" && !isClosed(mesh)) {
+  if (settings.shape == "mesh" && !isClosedManifold(mesh)) {
     // An open mesh: a shell `thickness` thick about its triangles, the unsigned distance less half of it.
     c.shell = thickness;
     const float half = float(0.5 * thickness);
-    grid = openvdb::tools::meshToVolume<FloatGrid>(adapter, *transform, float(half / voxel) + grids.fluid,
-                                                   0.0f, openvdb::tools::UNSIGNED_DISTANCE_FIELD,
-                                                   triangles->nearest.get());
+    grid = meshLevelSet(placed, *transform, float(half / voxel) + grids.fluid, 0.0f, /*unsignedDistance=*/true,
+                        triangles->nearest.get());
     for (auto value = grid->beginValueAll(); value; ++value) value.setValue(*value - half);
     grid->tree().root().setBackground(grid->background() - half, /*updateChildNodes=*/false);
     c.container = false;
   } else {
     const float exterior = c.container ? grids.solid : grids.fluid;
     const float interior = c.container ? grids.fluid : grids.solid;
-    grid = openvdb::tools::meshToVolume<FloatGrid>(adapter, *transform, exterior, interior, 0,
-                                                   triangles->nearest.get());
+    grid = meshLevelSet(placed, *transform, exterior, interior, /*unsignedDistance=*/false,
+                        triangles->nearest.get());
   }
   // Cut to the region, when the mesh's bands reach beyond it.
   Eigen::AlignedBox3d reach;

@@ -88,11 +88,41 @@ FloatGrid::Ptr emptyLevelSet(double voxel) {
   return grid;
 }
 
+// How a method's raw field becomes a level set (buildLevelSet): `spheres` on NarrowBand from the raw union;
+// the blended fields re-distanced by OpenVDB's LevelSetTracker first, then smoothed and eroded on NarrowBand
+// (smooth_spheres) or by tools::LevelSetFilter (anisotropic).
+enum class SmoothingRoute { NarrowBand, TrackedThenNarrowBand, TrackedAndFiltered };
+
+// One surface.method: its raster (particle_field.h), where its smoothed surface lies under the fluid's face,
+// and its smoothing. The erosion (erosionOf) is radius - h/2 - inset h when `fromRadius`, else -inset h (a
+// dilation), h the spacing.
+struct SurfaceMethod {
+  const char* name;
+  FieldKind raster;
+  bool fromRadius;
+  double inset;  // spacings
+  SmoothingRoute route;
+};
+
+constexpr SurfaceMethod kMethods[] = {
+    {"spheres", FieldKind::Spheres, true, kDentFill, SmoothingRoute::NarrowBand},
+    {"smooth_spheres", FieldKind::SmoothSpheres, true, kZbInset, SmoothingRoute::TrackedThenNarrowBand},
+    {"anisotropic", FieldKind::Anisotropic, false, kAnisoInset, SmoothingRoute::TrackedAndFiltered},
+};
+
 struct Parameters {
   double spacing = 0, radius = 0, voxel = 0;
   int layers = 1;  // copies of each particle along z (1 in 3D)
-  std::string method;
+  const SurfaceMethod* method = nullptr;
 };
+
+// surface.method by name; InputError naming the key for a name not in kMethods.
+const SurfaceMethod& surfaceMethod(const Scene& scene) {
+  for (const SurfaceMethod& m : kMethods)
+    if (scene.surface.method == m.name) return m;
+  throw InputError(scene.source.empty() ? "scene" : scene.source, "surface.method",
+                   "unknown method '" + scene.surface.method + "'");
+}
 
 Parameters resolve(const Scene& scene, int dimensions) {
   Parameters p;
@@ -101,7 +131,7 @@ Parameters resolve(const Scene& scene, int dimensions) {
   p.radius = scene.surface.particle_radius > 0 ? scene.surface.particle_radius : p.spacing;
   p.voxel = scene.surface.voxel_size > 0 ? scene.surface.voxel_size : p.radius / 2;
   p.layers = dimensions == 2 ? 2 * kSlabHalfLayers + 1 : 1;
-  p.method = scene.surface.method;
+  p.method = &surfaceMethod(scene);
   return p;
 }
 
@@ -179,23 +209,26 @@ BlockField rawLevelSet(const ParticleFrame& frame, const Parameters& p, double b
   f.radius = p.radius;
   f.occupancyCell = 2 * p.spacing;
   AnisotropicKernels kernels;
-  if (p.method == "spheres") {
-    f.kind = FieldKind::Spheres;
-  } else if (p.method == "smooth_spheres") {
-    f.kind = FieldKind::SmoothSpheres;
-    f.support = kZbSupport * p.spacing;
-  } else if (p.method == "anisotropic") {
-    AnisotropyParameters a;
-    a.spacing = p.spacing;
-    a.supportRadius = kAnisoSupport * p.spacing;
-    a.pcaRadius = kAnisoPca * p.spacing;
-    kernels = anisotropicKernels(x, a);
-    particles.kernels = &kernels;
-    f.kind = FieldKind::Anisotropic;
-    f.iso = kAnisoIso;
-    f.volume = kernels.particleVolume;
-  } else {
-    throw RunError("surface: unknown surface.method \"" + p.method + "\"");
+  f.kind = p.method->raster;
+  switch (p.method->raster) {
+    case FieldKind::Spheres:
+      break;
+    case FieldKind::SmoothSpheres:
+      f.support = kZbSupport * p.spacing;
+      break;
+    case FieldKind::Anisotropic: {
+      AnisotropyParameters a;
+      a.spacing = p.spacing;
+      a.supportRadius = kAnisoSupport * p.spacing;
+      a.pcaRadius = kAnisoPca * p.spacing;
+      kernels = anisotropicKernels(x, a);
+      particles.kernels = &kernels;
+      f.iso = kAnisoIso;
+      f.volume = kernels.particleVolume;
+      break;
+    }
+    case FieldKind::Velocity:
+      throw RunError("surface: surface.method '" + std::string(p.method->name) + "' rasterises no level set");
   }
   Progress::checkInterrupt();
   return rasterizeField(particles, f);
@@ -209,9 +242,9 @@ double erosionOf(const Parameters& p) {
   // h/sqrt(2) (for radius = h) between them. Eroding by radius - h/2 would put the sphere tops on the
   // fluid's face; the smoothed surface lies kDentFill * h under the tops, so that much less is eroded and the
   // faces land on the fluid's (a 20x10x10 block then encloses N h^3 less 1.75%, lost at its rounded edges).
-  if (p.method == "spheres") return p.radius - 0.5 * p.spacing - kDentFill * p.spacing;
-  if (p.method == "smooth_spheres") return p.radius - 0.5 * p.spacing - kZbInset * p.spacing;
-  return -kAnisoInset * p.spacing;
+  // (The anisotropic surface lies under the face instead, and is dilated.)
+  if (p.method->fromRadius) return p.radius - 0.5 * p.spacing - p.method->inset * p.spacing;
+  return -p.method->inset * p.spacing;
 }
 
 // Where the water meets a collider (collider_clip.h). The extension reaches as deep into the solid as the
@@ -322,7 +355,7 @@ FloatGrid::Ptr blendedLevelSet(const ParticleFrame& frame, const Parameters& p, 
   filter.normalize();
   filter.prune();  // voxels now beyond the band become inactive background
   Progress::checkInterrupt();
-  if (p.method == "smooth_spheres")
+  if (p.method->route == SmoothingRoute::TrackedThenNarrowBand)
     return smoothAndErode(blocksOf(*grid), p, smoothingSteps, /*firstIterations=*/0);
   // Anisotropic: 3 Eikonal iterations after each smoothing step (with one, the dilation below lost the block
   // 9% more; kRenormalise is still set), then the dilation in CFL steps, which grow the outer band as the
@@ -354,8 +387,16 @@ FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene,
     throw RunError("surface: particle " + std::to_string(far) +
                    " lies more than 2^22 voxels from the origin");
   const int steps = scene.surface.smoothing_steps;
-  FloatGrid::Ptr grid = p.method == "spheres" ? sphereLevelSet(frame, p, steps, colliders)
-                                              : blendedLevelSet(frame, p, steps, colliders);
+  FloatGrid::Ptr grid;
+  switch (p.method->route) {
+    case SmoothingRoute::NarrowBand:
+      grid = sphereLevelSet(frame, p, steps, colliders);
+      break;
+    case SmoothingRoute::TrackedThenNarrowBand:
+    case SmoothingRoute::TrackedAndFiltered:
+      grid = blendedLevelSet(frame, p, steps, colliders);
+      break;
+  }
   if (!colliders.empty()) clipByColliders(*grid, colliders, double(grid->background()));
   Progress::checkInterrupt();
   return grid;
@@ -573,6 +614,12 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
       },
       1);
   progress.finish();
+}
+
+std::vector<std::string> surfaceMethods() {
+  std::vector<std::string> names;
+  for (const SurfaceMethod& m : kMethods) names.emplace_back(m.name);
+  return names;
 }
 
 TriangleMesh meshParticles(const ParticleFrame& frame, const Scene& scene) {

@@ -55,6 +55,10 @@ SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const 
 void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& range, Progress& progress,
                    bool resume = false);
 
+// The names surface.method may take, in the surfacer's table (core/scene_fields.cpp's choices must be these; a
+// test checks). Another name is an InputError naming `surface.method`.
+std::vector<std::string> surfaceMethods();
+
 // For tests: the mesh of a frame, with no file written.
 TriangleMesh meshParticles(const ParticleFrame& frame, const Scene& scene);
 

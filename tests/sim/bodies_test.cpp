@@ -8,9 +8,12 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/errors.h"
 #include "core/ply.h"
 #include "core/scene.h"
+#include "geometry/shapes.h"
 #include "sim/pbf_solver.h"
+#include "sim/rigid_bodies.h"
 #include "sim/simulation.h"
 
 namespace surge {
@@ -329,6 +332,24 @@ TEST(Bodies, MomentumIsExchangedWithTheFluid) {
     EXPECT_NEAR((total - initial).norm(), 0.0, 0.02 * initial.norm()) << "frame " << f;
   }
   EXPECT_LT(rows[15].velocity.x(), 0.8);  // the water slowed the ball
+}
+
+// Bullet's table of body shapes (sim/rigid_bodies.cpp) takes exactly the kinds the shape table lets be a body;
+// any other is an error naming the key, never another shape in its place.
+TEST(Bodies, BulletTakesEveryBodyShapeAndRefusesTheRestNamingTheKey) {
+  for (const ShapeType& t : shapeTypes()) {
+    SCOPED_TRACE(t.name);
+    if (t.body) {
+      EXPECT_NO_THROW(checkBodyShape(t.kind, "test.json", "bodies[1]"));
+      continue;
+    }
+    try {
+      checkBodyShape(t.kind, "test.json", "bodies[1]");
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("bodies[1].shape"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

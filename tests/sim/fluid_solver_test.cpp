@@ -3,10 +3,9 @@
 
 #include <gtest/gtest.h>
 
-#include <regex>
-
 #include "core/errors.h"
 #include "sim/simulation.h"
+#include "tests/core/scene_choices.h"
 
 namespace surge {
 namespace {
@@ -19,25 +18,9 @@ Scene blockScene(const std::string& method) {
   return parseScene(json, "test", {});
 }
 
-// The methods a scene may name, as `surge keys` documents them ("one of `a`, `b`").
-std::vector<std::string> sceneMethods() {
-  const std::string table = sceneKeysMarkdown();
-  const size_t row = table.find("| `solver.method` |");
-  EXPECT_NE(row, std::string::npos);
-  const std::string line = table.substr(row, table.find('\n', row) - row);
-  const size_t oneOf = line.find("one of ");
-  EXPECT_NE(oneOf, std::string::npos);
-  const std::string choices = line.substr(oneOf, line.find('|', oneOf) - oneOf);
-  std::vector<std::string> methods;
-  const std::regex quoted("`([a-z0-9_]+)`");
-  for (auto it = std::sregex_iterator(choices.begin(), choices.end(), quoted); it != std::sregex_iterator(); ++it)
-    methods.push_back((*it)[1]);
-  return methods;
-}
-
 TEST(FluidSolver, EveryMethodASceneMayNameIsRegisteredAndNoOther) {
   const std::vector<std::string> registered = fluidSolverMethods();
-  EXPECT_EQ(sceneMethods(), registered);
+  EXPECT_EQ(sceneChoices("solver.method"), registered);
   EXPECT_GE(registered.size(), 2u);
 }
 

@@ -18,6 +18,7 @@
 
 #include "core/errors.h"
 #include "core/parallel.h"
+#include "tests/core/scene_choices.h"
 
 namespace surge {
 namespace {
@@ -157,6 +158,21 @@ void expectBallOfTheFluidsVolume(const char* method) {
   EXPECT_NEAR(phi[0], 0.0, voxel);
   EXPECT_LT(phi[1], 0.0);
   EXPECT_NEAR(phi[2], 3 * voxel, 1e-6);
+}
+
+TEST(Surfacer, EveryMethodASceneMayNameIsInTheTableAndNoOther) {
+  EXPECT_EQ(sceneChoices("surface.method"), surfaceMethods());
+}
+
+// A Scene made in code may name any method; one not in the table is refused naming the key.
+TEST(Surfacer, AnUnknownMethodIsAnInputErrorNamingTheKey) {
+  const ParticleFrame frame = block(4, 4, 4, 0.02, Eigen::Vector3d(0.1, 0.1, 0.1));
+  try {
+    meshParticles(frame, sceneWithSpacing(0.02, 3, "metaballs"));
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("surface.method"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Surfacer, BallOfParticlesGivesASphereOfTheFluidsVolume) {
