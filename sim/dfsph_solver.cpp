@@ -9,19 +9,15 @@
 namespace surge {
 namespace {
 
-
 // A particle with less than this fraction of the rest density around it (walls included) is at the free
 // surface: about 0.7 at a flat surface of the rest lattice, 0.95 one layer below it.
 constexpr float kSurfaceDensity = 0.8f;
-// The share of the last step's total lambda that starts each solve (measured in docs/speed-accuracy.md): the
-// hydrostatic pressure of a pool is most of the density solver's total and changes little from step to step,
-// so 0.8 of it took 4-13 iterations a step on the peer dam break where half of it (SPlisHSPlasH's choice) took
-// 24, at the same error; all of it pumped energy into a column at rest. The divergence solver starts from half
-// of its total, as SPlisHSPlasH's does.
+// The share of the last step's total lambda that starts each solve: the density solver's total is mostly the
+// pool's hydrostatic pressure, which changes little from step to step; the divergence solver starts from half,
+// as SPlisHSPlasH's does (docs/speed-accuracy.md has the measurements).
 constexpr float kDensityWarmStart = 0.8f, kDivergenceWarmStart = 0.5f;
-// The Jacobi relaxation omega: d_i = omega s_i / S_i. S_i is the diagonal of the solvers' matrix, whose
-// Jacobi iteration matrix has eigenvalues beyond 2 where particles have many neighbours: omega 0.7 and 1
-// diverged in the first frame of a dam break, 0.6 ran but with particles twice as fast as at 0.5.
+// The Jacobi relaxation omega: d_i = omega s_i / S_i. The iteration matrix has eigenvalues beyond 2 where
+// particles have many neighbours, so omega = 1 diverges (docs/speed-accuracy.md).
 constexpr float kRelaxation = 0.5f;
 
 }  // namespace

@@ -131,40 +131,6 @@ void PbfSolver<Dim>::predictPositions(float dt, double time) {
   });
 }
 
-// The collision response for the move of p*_i from `from`, against the colliders and the tank; each collider's
-// push is an impulse m delta / dt given to the particle (v = (x* - x) / dt at the end of the step). Where a
-// collider meets a wall (a ball on the floor), the wall's clamp can put the particle back into the collider:
-// then both act again, from there, up to kCornerRounds times, so the particle ends in the corner rather than
-// inside (alternating, the two close in on a narrow corner geometrically: one round left a particle 5.01% of
-// its radius inside a ball on the floor, past the 5% the rest test allows; four rounds kicked the corner's
-// particles harder, and a ball of density 2000 resting on the floor then moved at 2.03 cm/s, past its 2).
-// The clamp acts last: the tank always holds.
-// A corner round's push records no impulse: it is the tank's push passed on through a particle caught between
-// the tank and the collider. Recorded, it came back in every round of every iteration as m delta / dt for the
-// same overlap delta, a stiff spring with nothing to damp it, and a heavy box rested on a layer of caught
-// particles one spacing above the floor, rocking (docs/bodies.md). The particle's pressure still reaches the
-// collider through the density terms, and a body's contact with the tank is Bullet's.
-template <int Dim>
-void PbfSolver<Dim>::collide(size_t i, const VecD& from, bool fromStepStart) {
-  constexpr int kCornerRounds = 2;
-  auto pushed = [&](size_t c, const VecD& delta) { colliders_.addImpulse(i, c, (mass_ / stepDt_) * delta, p_[i]); };
-  colliders_.project(from, p_[i], fromStepStart, pushed);
-  for (int round = 0; round < kCornerRounds; ++round) {
-    if (walls_.clamp(p_[i]) == 0) return;
-    const VecD clamped = p_[i];
-    if (!colliders_.project(clamped, p_[i], false, [](size_t, const VecD&) {})) return;
-  }
-  walls_.clamp(p_[i]);
-}
-
-// Friction at the colliders, on the velocities of line 21.
-template <int Dim>
-void PbfSolver<Dim>::applyFriction() {
-  parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) colliders_.applyFriction(i, p_[i], v_[i], mass_);
-  });
-}
-
 // Lines 5-7: neighbours of x*. Particles are reordered by cell first, every step, for memory locality.
 template <int Dim>
 void PbfSolver<Dim>::findNeighbors() {
@@ -175,25 +141,13 @@ void PbfSolver<Dim>::findNeighbors() {
   sizeForPairs(neighbors_, pairGradientFactors_);
 }
 
-// Lines 8-19: Jacobi iterations on the density constraints. With solver.max_density_error > 0 the loop stops
-// early once the average density error is under it; solver.iterations caps it either way.
-// The Chebyshev semi-iterative acceleration (Wang 2015, "A Chebyshev Semi-Iterative Approach for Accelerating
-// Projective and Position-based Dynamics", eq. 12) weights iteration k by
+// Lines 8-19: Jacobi iterations on the density constraints, stopped early once the average density error is
+// under solver.max_density_error (> 0); solver.iterations caps them. Iterating to a tolerance with a cap of at
+// least SolverSettings::kChebyshevLeastIterations, they are Chebyshev-accelerated (Wang 2015, eq. 12):
 //   omega_1 = 1, omega_2 = 2 / (2 - rho^2), omega_k+1 = 4 / (4 - rho^2 omega_k),
-// rho being solver.chebyshev_rho, the spectral radius it assumes for the Jacobi iterations. The paper
-// extrapolates positions; here the extrapolation is of the step's summed multipliers Lambda (Lambda_k+1 =
-// omega (Lambda_k + lambda_k - Lambda_k-1) + Lambda_k-1), so the multiplier an iteration applies in eq. 12 is
-//   mu_k = omega_k lambda_k + (omega_k - 1) mu_k-1,
-// and it is kept only while the particle's constraint is active: a particle no longer compressed gets no push
-// from the momentum of earlier ones (computeLambdas). Extrapolating positions, as the paper does, kept moving
-// such particles, and a 2D dam break gained energy (docs/speed-accuracy.md).
-// It runs only when the loop iterates to solver.max_density_error. After a fixed handful of iterations its
-// polynomial leaves up to 1 / T_k(1 / rho) of the most local errors (19% at 4 iterations, rho = 0.85), which one
-// plain Jacobi iteration clears: a deep pool at the default 4 iterations stirred itself to 0.14 m/s RMS, against
-// 0.03 m/s without it. A tolerance that solver.iterations cuts short is the same case: a resting 3D pool
-// (0.6 x 0.3 x 0.6 m, spacing 0.02) iterated to 0.3% moved at 0.28 m/s RMS where the cap of 4 stopped every
-// step, 0.09 m/s at a cap of 6 and 0.05 m/s at 8, as plain Jacobi's 0.054 m/s; so it needs a cap of
-// SolverSettings::kChebyshevLeastIterations.
+// on the step's summed multipliers rather than the positions, so an iteration applies mu_k = omega_k lambda_k +
+// (omega_k - 1) mu_k-1 while the particle's constraint is active (computeLambdas). docs/speed-accuracy.md has
+// why the multipliers and why the cap.
 template <int Dim>
 void PbfSolver<Dim>::solveDensityConstraints() {
   const PhaseTimer timer(times_.pressure);
@@ -416,28 +370,6 @@ void PbfSolver<Dim>::applyPositionCorrections() {
   });
 }
 
-// The colliders' share of eq. 12 for particle i at p with lambda_i: (m / rho_0) lambda_i sum_c grad W_c, each
-// collider's part an impulse it gives the particle. The lambda pass found the colliders at p (found_); the
-// gradient of a single one, as most particles near any have, is kept from there. Kept out of the loop above,
-// which stays as it was for a scene without colliders (same instructions, same bytes).
-template <int Dim>
-typename PbfSolver<Dim>::VecD PbfSolver<Dim>::colliderCorrection(size_t i, const VecD& p, float lambda) {
-  auto share = [&](size_t c, const VecD& gradient) {
-    const VecD move = (massOverRho_ * lambda) * gradient;
-    colliders_.addImpulse(i, c, (mass_ / stepDt_) * move, p);
-    return move;
-  };
-  if (found_[i].count == 1) return share(found_[i].only, onlyGradient_[i]);
-  VecD delta = VecD::Zero();
-  colliders_.forEachNear(p, [&](size_t c, float d, const VecD& n) {
-    float unused;
-    VecD gradient;
-    colliders_.wallTerms(c, p, d, n, unused, gradient);
-    delta += share(c, gradient);
-  });
-  return delta;
-}
-
 // Line 21: v_i = (x*_i - x_i) / dt.
 template <int Dim>
 void PbfSolver<Dim>::updateVelocities(float dt) {
@@ -445,95 +377,6 @@ void PbfSolver<Dim>::updateVelocities(float dt) {
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) v_[i] = (p_[i] - x_[i]) * inverseDt;
   });
-}
-
-// Eq. 15: omega_i = sum_j (m / rho_0) v_ij x grad_{p_j} W(p_i - p_j), v_ij = v_j - v_i (a scalar in 2D): the
-// curl of the velocity in 1/s. The paper leaves out the particle volume m / rho_0 (it assumes 1, as for XSPH),
-// which made omega 1 / spacing^3 too large and a dam break at epsilon 0.001 throw a particle at 86 m/s.
-// Eq. 16: f_i = epsilon (N x omega_i), N = eta / |eta|, eta = grad |omega|_i = sum_j |omega_j| grad_{p_i} W.
-// The confinement force is applied as an acceleration: v_i += dt f_i.
-template <int Dim>
-void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
-  const PhaseTimer timer(times_.vorticity);
-  auto omegaMagnitude = [&](size_t j) { return Dim == 3 ? omega3_[j].norm() : std::abs(omega2_[j]); };
-  parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      Eigen::Vector3f omega = Eigen::Vector3f::Zero();
-      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
-        const VecD r = p_[i] - p_[*j];
-        const VecD gradientJ = -kernels_.spikyGradient(r, r.norm());  // grad with respect to p_j
-        Eigen::Vector3f vij = Eigen::Vector3f::Zero(), g = Eigen::Vector3f::Zero();
-        vij.head<Dim>() = v_[*j] - v_[i];
-        g.head<Dim>() = gradientJ;
-        omega += vij.cross(g);
-      }
-      omega *= massOverRho_;  // the particle volume m / rho_0: the paper's eq. 15 assumes a unit volume
-      if constexpr (Dim == 3) omega3_[i] = omega;
-      else omega2_[i] = omega.z();
-    }
-  });
-  parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      VecD eta = VecD::Zero();
-      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
-        const VecD r = p_[i] - p_[*j];
-        eta += (omegaMagnitude(*j) - omegaMagnitude(i)) * kernels_.spikyGradient(r, r.norm());
-      }
-      const float etaLength = eta.norm();
-      if (etaLength < 1e-12f) continue;
-      Eigen::Vector3f n = Eigen::Vector3f::Zero(), omega;
-      n.head<Dim>() = eta / etaLength;
-      if constexpr (Dim == 3) omega = omega3_[i];
-      else omega = Eigen::Vector3f(0, 0, omega2_[i]);
-      const Eigen::Vector3f force = vorticityEpsilon_ * n.cross(omega);
-      v_[i] += dt * force.head<Dim>();
-    }
-  });
-}
-
-// Eq. 17: v_i <- v_i + c sum_j (m / rho_0) v_ij W(p_i - p_j, h), with v_ij = v_j - v_i. The factor m / rho_0
-// (the particle volume) makes c dimensionless, as the paper's c = 0.01 assumes unit particle volume.
-template <int Dim>
-void PbfSolver<Dim>::applyXsphViscosity() {
-  const PhaseTimer timer(times_.forces);
-  std::vector<VecD>& smoothed = vectorScratch_;
-  smoothed.resize(size());
-  const float scale = xsphC_ * massOverRho_;
-  parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      VecD sum = VecD::Zero();
-      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j)
-        sum += (v_[*j] - v_[i]) * kernels_.poly6((p_[i] - p_[*j]).squaredNorm());
-      smoothed[i] = v_[i] + scale * sum;
-    }
-  });
-  v_.swap(smoothed);
-}
-
-// p_i - p_j, or coincidentOffset for a pair closer than coincidentLength_.
-template <int Dim>
-typename PbfSolver<Dim>::VecD PbfSolver<Dim>::pairOffset(size_t i, size_t j, const VecD& pi) const {
-  const VecD r = pi - p_[j];
-  if (r.squaredNorm() <= coincidentLength_ * coincidentLength_) [[unlikely]] return coincidentOffset(i, j);
-  return r;
-}
-
-// Two particles on the same point (the walls project every particle that overshoots a corner onto the same
-// corner) have no kernel gradient between them, so no constraint could ever part them, and their summed density
-// would push their neighbours ever harder. Such a pair is given a tiny offset along a direction that depends on
-// the pair only and flips with its order (so momentum is still conserved).
-template <int Dim>
-typename PbfSolver<Dim>::VecD PbfSolver<Dim>::coincidentOffset(size_t i, size_t j) const {
-  const uint32_t lo = static_cast<uint32_t>(std::min(i, j)), hi = static_cast<uint32_t>(std::max(i, j));
-  uint32_t hash = lo * 0x9E3779B1u ^ (hi + 0x7F4A7C15u) * 0x85EBCA77u;
-  VecD direction;
-  for (int k = 0; k < Dim; ++k) {
-    hash ^= hash >> 15;
-    hash *= 0x2C1B3C6Du;
-    direction[k] = static_cast<float>(hash & 0xFFFF) / 32768.0f - 1.0f;
-  }
-  direction[0] += 1e-3f;  // never the zero vector
-  return (i < j ? coincidentLength_ : -coincidentLength_) * direction.normalized();
 }
 
 // Density error of DESIGN.md at the current positions, with the neighbour lists of the last step.

@@ -15,6 +15,7 @@
 #include "core/errors.h"
 #include "geometry/pose.h"
 #include "sim/fluid_solver.h"
+#include "sim/frame_outputs.h"
 #include "sim/rigid_bodies.h"
 #include "sim/solver_defaults.h"
 
@@ -27,66 +28,6 @@ std::string formatVector(const Eigen::Vector3f& v, int dimensions) {
   if (dimensions == 3) out << ", " << v.z();
   out << ")";
   return out.str();
-}
-
-// A per-frame table (stats.csv, colliders.csv, bodies.csv). Opening it writes the header, and on resume the rows
-// of the frames up to the one resumed from, as a whole new file; each frame's rows are then appended by one
-// write, so that a run of 10^7 frames costs its rows once, not the file again at every frame. A row cut short
-// by a kill (no newline) is dropped on resume, as are the rows of frames after the one resumed from.
-class CsvFile {
- public:
-  CsvFile(fs::path path, const std::string& header, bool resume, int resumeFrame) : path_(std::move(path)) {
-    std::string kept = header + "\n";
-    if (resume) {
-      std::error_code error;
-      const std::string text = fs::exists(path_, error) ? readTextFile(path_) : std::string();
-      size_t begin = text.find('\n');  // after the header
-      while (begin != std::string::npos && begin + 1 < text.size()) {
-        const size_t end = text.find('\n', begin + 1);
-        if (end == std::string::npos) break;  // the last row, cut short
-        const std::string line = text.substr(begin + 1, end - begin - 1);
-        if (!line.empty() && std::atoi(line.c_str()) <= resumeFrame) kept += line + "\n";
-        begin = end;
-      }
-    }
-    writeFileAtomically(path_, [&](std::ostream& out) { out << kept; });
-  }
-  void add(const std::string& row) {
-    const std::string line = row + "\n";
-    const int file = ::open(path_.c_str(), O_WRONLY | O_APPEND);
-    if (file < 0) throw RunError("cannot append to " + path_.string() + ": " + writeFailure(errno));
-    errno = 0;
-    const ssize_t written = ::write(file, line.data(), line.size());
-    const int error = written < 0 ? errno : ENOSPC;  // a short write: the disk filled during it
-    ::close(file);
-    if (written != ssize_t(line.size())) throw RunError("cannot append to " + path_.string() + ": " + writeFailure(error));
-  }
-
- private:
-  fs::path path_;
-};
-
-// pressureMax is NaN for a solver without pressures (PBF), divergenceIterations for one without a divergence
-// solver (PBF, WCSPH); either is then written as an empty field.
-std::string statsRow(int frame, double time, size_t particles, int substeps, double iterations,
-                     const FluidMeasures& m, double wallSeconds, const PhaseTimes& t, double timeStep,
-                     double pressureMax, const DamBreakMeasures& dam, double divergenceIterations) {
-  char row[512];
-  std::snprintf(row, sizeof row, "%d,%.6f,%zu,%d,%.2f,%.6g,%.6g,%.6g,%.4f,%.2f,%.2f,%.2f,%.2f,%.6g,", frame, time,
-                particles, substeps, iterations, m.densityErrorAvg, m.densityErrorMax, m.kineticEnergy,
-                wallSeconds, t.neighbors, t.pressure, t.vorticity, t.forces, timeStep);
-  std::string text = row;
-  if (!std::isnan(pressureMax)) {
-    std::snprintf(row, sizeof row, "%.6g", pressureMax);
-    text += row;
-  }
-  text += ",";
-  if (!std::isnan(divergenceIterations)) {
-    std::snprintf(row, sizeof row, "%.2f", divergenceIterations);
-    text += row;
-  }
-  std::snprintf(row, sizeof row, ",%.6g,%.6g", dam.frontX, dam.backHeight);
-  return text + row;
 }
 
 void removeStaleFiles(const fs::path& folder, bool framesToo) {
@@ -127,135 +68,50 @@ float walkWhileContiguous(const std::vector<float>& sorted, size_t start, float 
                  " m/s, ten times the fastest the scene can give it)");
 }
 
-// One colliders.csv row a collider: the frame's mean force (N) and torque about the collider's position (N m).
-std::string colliderRows(const Scene& scene, int frame, const std::vector<Wrench>& wrenches) {
-  std::string rows;
-  for (size_t c = 0; c < wrenches.size(); ++c) {
-    char row[512];
-    const Wrench& w = wrenches[c];
-    std::snprintf(row, sizeof row, "%d,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g", frame, scene.colliders[c].name.c_str(),
-                  w.force.x(), w.force.y(), w.force.z(), w.torque.x(), w.torque.y(), w.torque.z());
-    rows += (rows.empty() ? "" : "\n") + std::string(row);
-  }
-  return rows;
-}
-
-// A shape's mesh placed in the world by `pose`.
-TriangleMesh placedMesh(TriangleMesh mesh, const Pose& pose) {
-  for (Eigen::Vector3f& p : mesh.positions) p = pose.toWorld(p.cast<double>()).cast<float>();
-  for (Eigen::Vector3f& n : mesh.normals) n = (pose.rotation * n.cast<double>()).cast<float>();
-  return mesh;
-}
-
-// A collider's mesh placed in the world at `time`.
-TriangleMesh placedMesh(const ColliderSettings& settings, const ColliderShape& shape, double time) {
-  return placedMesh(shape.mesh, colliderPose(settings, time));
-}
-
-// colliders/<name>.ply: each collider's mesh in the world as it stands at time 0, so that the later stages and
-// Blender never reload the scene's own files. A new run starts the folder afresh.
-void writeColliderMeshes(const Scene& scene, const ColliderShapes& shapes, const fs::path& dir, bool resume) {
-  const fs::path folder = dir / "colliders";
-  std::error_code error;
-  if (!resume) fs::remove_all(folder, error);
-  fs::create_directories(folder);
-  for (size_t c = 0; c < scene.colliders.size(); ++c) {
-    writeMeshPly(folder / (scene.colliders[c].name + ".ply"), placedMesh(scene.colliders[c], shapes[c], 0.0));
-    if (isMoving(scene.colliders[c])) {
-      fs::create_directories(folder / scene.colliders[c].name);
-      const fs::path first = framePath(folder, scene.colliders[c].name, 0, "ply");
-      if (!fs::exists(first, error)) writeMeshPly(first, placedMesh(scene.colliders[c], shapes[c], 0.0));
+// The frame loop, for any solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
+// otherwise each step is the largest stable one (stableTimeStep) shortened so the steps left end exactly on the
+// frame: dt = remaining / ceil(remaining / stable).
+// The particles run() starts from: the newest frame of a resumed run (with the method's carried state and the
+// bodies' states there), or the scene's fluid less what lies inside colliders and bodies.
+template <int Dim>
+void startParticles(const Scene& scene, const fs::path& dir, bool resume, FluidSolver<Dim>& solver,
+                    RigidBodies* bodies, SimulationSummary& summary) {
+  const std::vector<int> existing = resume ? listFrames(dir, "particles", "ply") : std::vector<int>{};
+  if (existing.empty()) {
+    ParticleFrame initial = initialParticles(scene);
+    if (!scene.colliders.empty() || bodies) {
+      summary.removedParticles = removeParticlesInside(solver.colliders(), initial);
+      if (initial.size() == 0)
+        throw InputError(scene.source, scene.colliders.empty() ? "bodies" : "colliders",
+                         "every fluid particle lies inside a collider or a body");
     }
+    solver.setParticles(initial);
+    return;
   }
-}
-
-// colliders/<name>/frame_NNNNN.ply: a moving collider's mesh at each frame.
-void writeMovingColliderMeshes(const Scene& scene, const ColliderShapes& shapes, const fs::path& dir, int frame) {
-  for (size_t c = 0; c < scene.colliders.size(); ++c)
-    if (isMoving(scene.colliders[c]))
-      writeMeshPly(framePath(dir / "colliders", scene.colliders[c].name, frame, "ply"),
-                   placedMesh(scene.colliders[c], shapes[c], frame / scene.output.fps));
-}
-
-// One bodies.csv row a body: its state at the frame's end and the fluid's mean wrench on it over the frame.
-std::string bodyRows(const Scene& scene, int frame, const std::vector<BodyState>& states,
-                     const std::vector<Wrench>& wrenches) {
-  std::string rows;
-  for (size_t b = 0; b < states.size(); ++b) {
-    const BodyState& s = states[b];
-    const Wrench& w = wrenches[b];
-    char row[768];
-    std::snprintf(row, sizeof row,
-                  "%d,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g",
-                  frame, scene.bodies[b].solid.name.c_str(), s.position.x(), s.position.y(), s.position.z(),
-                  s.orientation.w(), s.orientation.x(), s.orientation.y(), s.orientation.z(), s.velocity.x(),
-                  s.velocity.y(), s.velocity.z(), s.angularVelocity.x(), s.angularVelocity.y(),
-                  s.angularVelocity.z(), w.force.x(), w.force.y(), w.force.z(), w.torque.x(), w.torque.y(),
-                  w.torque.z());
-    rows += (rows.empty() ? "" : "\n") + std::string(row);
-  }
-  return rows;
-}
-
-// bodies/<name>/frame_NNNNN.ply: each body's mesh in the world at the frame (and bodies/<name>.ply at frame 0),
-// and bodies/frame_NNNNN.txt, the exact state a resumed run starts from.
-void writeBodyFrame(const Scene& scene, const ColliderShapes& shapes, const RigidBodies& bodies,
-                    const fs::path& dir, int frame) {
-  const fs::path folder = dir / "bodies";
-  for (size_t b = 0; b < bodies.size(); ++b) {
-    const TriangleMesh mesh = placedMesh(shapes[scene.colliders.size() + b].mesh, bodies.pose(b));
-    const std::string& name = scene.bodies[b].solid.name;
-    fs::create_directories(folder / name);
-    if (frame == 0) writeMeshPly(folder / (name + ".ply"), mesh);
-    writeMeshPly(framePath(folder, name, frame, "ply"), mesh);
-  }
-  writeBodyStates(framePath(dir, "bodies", frame, "txt"), scene, bodies.states());
-}
-
-// A method's carried state (FluidSolver::carriedState) at frame f: solver/frame_NNNNN.bin, raw floats, written
-// before the particle frame (which commits the frame). Only the last two are kept: a run resumes from its last.
-void writeCarriedState(const fs::path& dir, int frame, const std::vector<float>& state) {
-  fs::create_directories(dir / "solver");
-  writeFileAtomically(framePath(dir, "solver", frame, "bin"), [&](std::ostream& out) {
-    out.write(reinterpret_cast<const char*>(state.data()), std::streamsize(state.size() * sizeof(float)));
-  });
-  std::error_code error;
-  if (frame >= 2) fs::remove(framePath(dir, "solver", frame - 2, "bin"), error);
-}
-
-std::vector<float> readCarriedState(const fs::path& dir, int frame, size_t count) {
-  const fs::path path = framePath(dir, "solver", frame, "bin");
-  std::error_code error;
-  if (!fs::exists(path, error))
-    throw RunError("cannot resume from frame " + std::to_string(frame) + ": " + path.string() +
-                   ", the solver's state there, is missing");
-  const std::string bytes = readTextFile(path);
-  if (bytes.size() != count * sizeof(float))
-    throw RunError("cannot resume from frame " + std::to_string(frame) + ": " + path.string() + " holds " +
-                   std::to_string(bytes.size()) + " bytes, not the " + std::to_string(count * sizeof(float)) +
-                   " of this scene's particles");
-  std::vector<float> state(count);
-  std::memcpy(state.data(), bytes.data(), bytes.size());
-  return state;
+  summary.firstFrame = std::min(existing.back(), scene.output.frames);
+  const fs::path path = framePath(dir, "particles", summary.firstFrame, "ply");
+  const ParticleFrame frame = readParticlePly(path);
+  if (frame.dimensions != Dim) throw InputError(path.string(), "dimensions", "differs from the scene's");
+  solver.setParticles(frame);
+  const size_t carried = solver.carriedState().size();
+  if (carried > 0 && summary.firstFrame < scene.output.frames)
+    solver.restoreCarriedState(readCarriedState(dir, summary.firstFrame, carried));
+  if (bodies) bodies->setStates(readBodyStates(framePath(dir, "bodies", summary.firstFrame, "txt"), scene));
 }
 
 // The frame loop, for any solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
 // otherwise each step is the largest stable one (stableTimeStep) shortened so the steps left end exactly on the
-// frame: dt = remaining / ceil(remaining / stable).
+// frame: dt = remaining / ceil(remaining / stable). Each frame's record goes to every FrameOutput.
 template <int Dim>
 SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
                       bool resume, Progress& progress) {
   const auto runStart = std::chrono::steady_clock::now();
-  const fs::path particleDir = dir / "particles";
-  removeStaleFiles(particleDir, !resume);
+  removeStaleFiles(dir / "particles", !resume);
   removeStaleFiles(dir / "solver", !resume);
-  fs::create_directories(particleDir);
+  fs::create_directories(dir / "particles");
 
   const std::unique_ptr<FluidSolver<Dim>> method = makeFluidSolver<Dim>(scene, shapes);
   FluidSolver<Dim>& solver = *method;
-  SimulationSummary summary;
-  const bool colliding = !scene.colliders.empty();
-  if (colliding) writeColliderMeshes(scene, *shapes, dir, resume);
   std::unique_ptr<RigidBodies> bodies;
   if (!scene.bodies.empty()) {
     bodies = std::make_unique<RigidBodies>(scene, shapes);
@@ -263,50 +119,26 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     if (!resume) fs::remove_all(dir / "bodies", error);
     fs::create_directories(dir / "bodies");
   }
-  const std::vector<int> existing = resume ? listFrames(dir, "particles", "ply") : std::vector<int>{};
-  if (!existing.empty()) {
-    summary.firstFrame = std::min(existing.back(), scene.output.frames);
-    const fs::path path = framePath(dir, "particles", summary.firstFrame, "ply");
-    const ParticleFrame frame = readParticlePly(path);
-    if (frame.dimensions != Dim) throw InputError(path.string(), "dimensions", "differs from the scene's");
-    solver.setParticles(frame);
-    const size_t carried = solver.carriedState().size();
-    if (carried > 0 && summary.firstFrame < scene.output.frames)
-      solver.restoreCarriedState(readCarriedState(dir, summary.firstFrame, carried));
-    if (bodies) bodies->setStates(readBodyStates(framePath(dir, "bodies", summary.firstFrame, "txt"), scene));
-  } else {
-    ParticleFrame initial = initialParticles(scene);
-    if (colliding || bodies) {
-      summary.removedParticles = removeParticlesInside(solver.colliders(), initial);
-      if (initial.size() == 0)
-        throw InputError(scene.source, colliding ? "colliders" : "bodies",
-                         "every fluid particle lies inside a collider or a body");
-    }
-    solver.setParticles(initial);
-  }
-  const bool fresh = existing.empty();
-  CsvFile stats(dir / "stats.csv", statsCsvHeader(), !fresh, summary.firstFrame);
-  std::unique_ptr<CsvFile> colliderTable, bodyTable;
-  if (colliding)
-    colliderTable = std::make_unique<CsvFile>(dir / "colliders.csv", collidersCsvHeader(), !fresh, summary.firstFrame);
-  if (bodies)
-    bodyTable = std::make_unique<CsvFile>(dir / "bodies.csv", bodiesCsvHeader(), !fresh, summary.firstFrame);
+  SimulationSummary summary;
+  startParticles<Dim>(scene, dir, resume, solver, bodies.get(), summary);
+  const bool fresh = !resume || listFrames(dir, "particles", "ply").empty();
+  const std::vector<std::unique_ptr<FrameOutput>> outputs =
+      makeFrameOutputs(scene, shapes, bodies.get(), dir, resume, !fresh, summary.firstFrame);
   ParticleFrame frame;
+  FrameRecord record;
+  record.particles = &frame;
+  auto writeFrame = [&] {
+    record.dam = measureDamBreak(scene, frame);
+    record.carriedState = solver.carriedState();
+    for (const std::unique_ptr<FrameOutput>& output : outputs) output->write(record);
+  };
   if (fresh) {
     // Measured first: before the first step, measuring sorts the particles into cells, and frame 0 must hold
-    // them in the order the run goes on with, or a run resumed from it sorts a different order into the cells
-    // and sums its neighbours in another order.
-    const FluidMeasures measures = solver.measure();
+    // them in the order the run goes on with, or a run resumed from it sums its neighbours in another order.
+    record.measures = solver.measure();
     solver.getParticles(frame);
-    stats.add(statsRow(0, 0.0, solver.size(), 0, 0, measures, 0.0, PhaseTimes{}, 0.0, NAN,
-                       measureDamBreak(scene, frame), solver.lastDivergenceIterations() < 0 ? NAN : 0.0));
-    if (bodies) {
-      bodyTable->add(bodyRows(scene, 0, bodies->states(), std::vector<Wrench>(bodies->size())));
-      writeBodyFrame(scene, *shapes, *bodies, dir, 0);
-    }
-    const std::vector<float> state = solver.carriedState();
-    if (!state.empty()) writeCarriedState(dir, 0, state);
-    writeParticlePly(framePath(dir, "particles", 0, "ply"), frame);
+    if (solver.lastDivergenceIterations() >= 0) record.divergenceIterations = 0;
+    writeFrame();
   }
 
   const double frameDuration = 1.0 / scene.output.fps;
@@ -353,30 +185,26 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
         throw RunError("simulation stalled at frame " + std::to_string(f) + ": a million steps of " +
                        std::to_string(dt) + " s did not finish the frame (the stable step collapsed)");
     }
-    const FluidMeasures measures = solver.measure();
+    record = FrameRecord{};
+    record.particles = &frame;
+    record.frame = f;
+    record.time = f * frameDuration;
+    record.measures = solver.measure();
     solver.getParticles(frame);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart).count();
-    // The row first, the frame second: a run killed between them resumes from the frame before, whose rows
-    // are the ones kept, so stats.csv never misses a frame that is on disk.
-    stats.add(statsRow(f, f * frameDuration, solver.size(), steps, double(iterations) / steps, measures, seconds,
-                       solver.phaseTimes(), smallestStep, solver.maxPressure(), measureDamBreak(scene, frame),
-                       divergenceIterations < 0 ? NAN : double(divergenceIterations) / steps));
-    if (colliding || bodies) {
+    record.steps = steps;
+    record.iterations = double(iterations) / steps;
+    record.divergenceIterations = divergenceIterations < 0 ? NAN : double(divergenceIterations) / steps;
+    record.smallestStep = smallestStep;
+    record.pressureMax = solver.maxPressure();
+    record.phases = solver.phaseTimes();
+    record.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart).count();
+    if (!scene.colliders.empty() || bodies) {
       std::vector<Wrench> wrenches = solver.takeColliderWrenches(frameDuration);
       const auto firstBody = wrenches.begin() + std::ptrdiff_t(scene.colliders.size());
-      if (bodies) {
-        bodyTable->add(bodyRows(scene, f, bodies->states(), std::vector<Wrench>(firstBody, wrenches.end())));
-        writeBodyFrame(scene, *shapes, *bodies, dir, f);
-      }
-      wrenches.erase(firstBody, wrenches.end());
-      if (colliding) {
-        colliderTable->add(colliderRows(scene, f, wrenches));
-        writeMovingColliderMeshes(scene, *shapes, dir, f);
-      }
+      record.bodyWrenches.assign(firstBody, wrenches.end());
+      record.colliderWrenches.assign(wrenches.begin(), firstBody);
     }
-    const std::vector<float> state = solver.carriedState();
-    if (!state.empty()) writeCarriedState(dir, f, state);
-    writeParticlePly(framePath(dir, "particles", f, "ply"), frame);
+    writeFrame();
     progress.advance();
   }
   progress.finish();
@@ -387,12 +215,6 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
 }
 
 }  // namespace
-
-const char* statsCsvHeader() {
-  return "frame,time,particles,substeps,iterations,density_error_avg,density_error_max,kinetic_energy,"
-         "wall_seconds,ms_neighbors,ms_constraint,ms_vorticity,ms_viscosity,time_step,pressure_max,divergence_iterations,"
-         "front_x,back_height";
-}
 
 DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame) {
   DamBreakMeasures m;
@@ -456,11 +278,6 @@ SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderSha
                            bool resume, Progress& progress) {
   return scene.dimensions == 2 ? run<2>(scene, shapes, dir, resume, progress)
                                : run<3>(scene, shapes, dir, resume, progress);
-}
-
-const char* collidersCsvHeader() { return "frame,collider,fx,fy,fz,tx,ty,tz"; }
-const char* bodiesCsvHeader() {
-  return "frame,body,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,fx,fy,fz,tx,ty,tz";
 }
 
 }  // namespace surge

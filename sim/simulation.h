@@ -6,6 +6,7 @@
 #include "core/progress.h"
 #include "core/scene.h"
 #include "sim/colliders.h"
+#include "sim/frame_outputs.h"
 
 namespace surge {
 
@@ -44,18 +45,11 @@ SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderSha
 //   backHeight  the height of the water column at the start wall: the particles within one kernel radius of
 //               it, walked up from the floor the same way (0 if none touches the floor there), plus half a
 //               spacing, measured from domain.min.y.
-struct DamBreakMeasures {
-  double frontX = 0, backHeight = 0;
-};
 DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame);
 
 // True for a scene whose fluid is one box on the floor against one x wall (and not the other): a dam break,
 // whose front_x and back_height can be compared with experiments (Martin & Moyce 1952) and across runs.
 bool isDamBreak(const Scene& scene);
 
-// The columns of stats.csv, colliders.csv and bodies.csv, in order.
-const char* statsCsvHeader();
-const char* collidersCsvHeader();
-const char* bodiesCsvHeader();
 
 }  // namespace surge

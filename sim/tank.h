@@ -1,4 +1,4 @@
-// What both solvers share about the rest lattice and the tank:
+// What every method shares about the rest lattice and the tank:
 //  - latticeSums: sums of a kernel and of its squared gradient over the rest lattice around an interior
 //    particle, to choose the particle mass (the rest lattice has exactly rho_0) and scale PBF's epsilon;
 //  - TankWalls: the tank's walls as the rest lattice continued beyond them (after the boundary particles of
