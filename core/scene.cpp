@@ -1,12 +1,12 @@
+// Reading and writing a scene (core/scene.h): JSON in, with its types, ranges, unknown keys, --set overrides and
+// the non-finite words scripts write; JSON out (scene.json and the stages' settings); and the key table of
+// `surge keys`. Every one is a visitor over the keys as scene_fields.cpp declares them; the checks that need the
+// whole scene are core/scene_validate.cpp's.
 #include "core/scene.h"
 
-#include <unistd.h>
-
+#include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstdlib>
-#include <fstream>
-#include <iomanip>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -24,12 +24,6 @@ std::string describe(const json& value) {
   std::string text = value.dump(-1, ' ', false, json::error_handler_t::replace);
   if (text.size() > 40) text = text.substr(0, 37) + "...";
   return text;
-}
-
-std::string formatNumber(double value) {
-  std::ostringstream out;
-  out << std::setprecision(10) << value;
-  return out.str();
 }
 
 std::string rangeText(const FieldInfo& info) {
@@ -408,172 +402,7 @@ void applyOverride(json& root, const std::string& assignment, std::set<std::stri
   overridden.insert(normalisedPath(parts));
 }
 
-bool isPlainName(const std::string& name) {
-  if (name.empty() || name.front() == '.') return false;
-  for (char c : name)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') return false;
-  return true;
-}
-
-void validateRotation(const Rotation& r, int dimensions, const std::string& where, const std::string& key) {
-  if (!(r.axis.norm() > 0)) throw InputError(where, key + ".axis", "must not be the zero vector");
-  if (dimensions == 2 && r.degrees != 0 && (std::abs(r.axis.x()) > 0 || std::abs(r.axis.y()) > 0))
-    throw InputError(where, key + ".axis", "in 2D a rotation is about z: leave the axis out or make it [0, 0, 1]");
-}
-
-// What can be checked of the colliders without reading their files (geometry/collider_shape.cpp checks those).
-// What colliders and bodies share: a unique plain name, a shape with the parameters it needs.
-void validateSolid(ColliderSettings& c, const std::string& key, const std::string& defaultName, int dimensions,
-                   std::set<std::string>& names, const std::string& where) {
-  if (c.name.empty()) c.name = defaultName;
-  if (!isPlainName(c.name))
-    throw InputError(where, key + ".name", "must be letters, digits, '-', '_' or '.', not starting with '.'");
-  if (!names.insert(c.name).second)
-    throw InputError(where, key + ".name", "'" + c.name + "' is used twice");
-  validateRotation(c.rotation, dimensions, where, key + ".rotation");
-  if (c.shape == "box") {
-    if (c.size.size() != size_t(dimensions))
-      throw InputError(where, key + ".size",
-                       "a box needs its full extents, " + std::to_string(dimensions) + " numbers");
-  } else if (c.shape == "heightfield") {
-    if (c.size.size() != 2) throw InputError(where, key + ".size", "a heightfield needs its [x, z] extents");
-  } else if (!c.size.empty()) {
-    throw InputError(where, key + ".size", "only a box or a heightfield has a size");
-  }
-  for (double extent : c.size)
-    if (!(extent > 0)) throw InputError(where, key + ".size", "extents must be > 0");
-  if ((c.shape == "heightfield" || c.shape == "mesh") && c.file.empty())
-    throw InputError(where, key + ".file", "a " + c.shape + " needs a file");
-  if (c.shape != "heightfield" && c.shape != "mesh" && !c.file.empty())
-    throw InputError(where, key + ".file", "only a heightfield or a mesh reads a file");
-}
-
-// What can be checked of the colliders and bodies without reading their files (geometry/collider_shape.cpp
-// checks those; sim/rigid_bodies.cpp checks that bodies do not overlap at the start).
-void validateSolids(Scene& s, const std::string& where) {
-  std::set<std::string> names;
-  for (size_t i = 0; i < s.colliders.size(); ++i) {
-    ColliderSettings& c = s.colliders[i];
-    const std::string key = "colliders[" + std::to_string(i) + "]";
-    validateSolid(c, key, "collider" + std::to_string(i), s.dimensions, names, where);
-    if (c.shape == "plane") {
-      if (!(c.normal.norm() > 0)) throw InputError(where, key + ".normal", "must not be the zero vector");
-      if (c.container) throw InputError(where, key + ".container", "a plane cannot hold fluid; turn its normal");
-    }
-    if (c.thickness == 0) c.thickness = s.particle_spacing;
-    for (size_t k = 0; k < c.motion.size(); ++k) {
-      const std::string frameKey = key + ".motion[" + std::to_string(k) + "]";
-      validateRotation(c.motion[k].rotation, s.dimensions, where, frameKey + ".rotation");
-      if (k > 0 && c.motion[k].time < c.motion[k - 1].time)
-        throw InputError(where, frameKey + ".time", "keyframes must be in time order");
-    }
-  }
-  for (size_t i = 0; i < s.bodies.size(); ++i) {
-    BodySettings& b = s.bodies[i];
-    const std::string key = "bodies[" + std::to_string(i) + "]";
-    validateSolid(b.solid, key, "body" + std::to_string(i), s.dimensions, names, where);
-    if (b.solid.shape == "mesh" && s.dimensions == 2)
-      throw InputError(where, key + ".shape", "a mesh body needs 3 dimensions");
-    if ((b.density > 0) == (b.mass > 0))
-      throw InputError(where, key + (b.density > 0 ? ".mass" : ".density"),
-                       "give a body its density or its mass (> 0), not both");
-    b.solid.thickness = s.particle_spacing;
-    if (s.dimensions == 2) {
-      // Motion in the plane: no z velocity, no spin but about z.
-      b.velocity.z() = 0;
-      b.angular_velocity.x() = b.angular_velocity.y() = 0;
-    }
-  }
-}
-
-void validate(Scene& s, const std::string& where) {
-  // The default output folder is out/<name>: a scene file must not choose where Surge writes.
-  if (!isPlainName(s.name))
-    throw InputError(where, "name", "must be a plain file name: letters, digits, '-', '_' or '.', not starting with '.'");
-  const int d = s.dimensions;
-  for (int k = 0; k < d; ++k)
-    if (!(s.domain.min[k] < s.domain.max[k]))
-      throw InputError(where, "domain", "min must be below max on every axis");
-  for (size_t i = 0; i < s.fluids.size(); ++i) {
-    const std::string key = "fluids[" + std::to_string(i) + "].box";
-    const Box& b = s.fluids[i].box;
-    for (int k = 0; k < d; ++k) {
-      if (!(b.min[k] < b.max[k])) throw InputError(where, key, "min must be below max on every axis");
-      if (b.min[k] < s.domain.min[k] || b.max[k] > s.domain.max[k])
-        throw InputError(where, key, "lies outside the domain");
-    }
-  }
-  const double spacing = s.particle_spacing;
-  const size_t count = s.particleCount();
-  if (count == 0)
-    throw InputError(where, "fluids",
-                     "the fluid boxes hold no particles at particle_spacing " + formatNumber(spacing));
-
-  SolverSettings& solver = s.solver;
-  if (solver.kernel_radius == 0) solver.kernel_radius = 2 * spacing;
-  if (solver.kernel_radius <= spacing)
-    throw InputError(where, "solver.kernel_radius", "must exceed particle_spacing, or particles have no neighbours");
-  // The neighbour grid covers the particles' box only (sparsely if need be); cell coordinates must fit.
-  for (int k = 0; k < d; ++k)
-    if ((s.domain.max[k] - s.domain.min[k]) / solver.kernel_radius > double(1 << 20))
-      throw InputError(where, "domain", "spans more than 2^20 kernel radii along an axis");
-
-  for (size_t i = 1; i < s.attractor.keyframes.size(); ++i)
-    if (s.attractor.keyframes[i].time < s.attractor.keyframes[i - 1].time)
-      throw InputError(where, "attractor.keyframes[" + std::to_string(i) + "].time", "keyframes must be in time order");
-
-  validateSolids(s, where);
-
-  SurfaceSettings& surface = s.surface;
-  if (surface.particle_radius == 0) surface.particle_radius = spacing;
-  if (surface.voxel_size == 0) surface.voxel_size = surface.particle_radius / 2;
-  if (surface.voxel_size > surface.particle_radius / 1.5)
-    throw InputError(where, "surface.voxel_size",
-                     "above particle_radius / 1.5: OpenVDB would drop every particle sphere");
-  // The surfacer keys its blocks of 8^3 voxels by 21-bit coordinates about the origin (2^23 voxels each way);
-  // half that leaves room for the band around the domain.
-  for (int k = 0; k < d; ++k)
-    if (std::max(std::abs(s.domain.min[k]), std::abs(s.domain.max[k])) / surface.voxel_size > double(1 << 22))
-      throw InputError(where, "surface.voxel_size", "the domain reaches more than 2^22 voxels from the origin");
-
-  CameraSettings& camera = s.render.camera;
-  if (camera.position == camera.look_at) {
-    // Frame the domain: look at its centre from the front, raised and turned a little (straight on in 2D).
-    const Eigen::Vector3d centre = 0.5 * (s.domain.min + s.domain.max);
-    const Eigen::Vector3d extent = s.domain.max - s.domain.min;
-    const double tanHalf = std::tan(camera.fov * M_PI / 360.0);
-    const double aspect = double(s.render.width) / double(s.render.height);
-    const double fitHeight = 0.5 * extent.y() / tanHalf;
-    const double fitWidth = 0.5 * extent.x() / (tanHalf * aspect);
-    const double distance = 1.4 * std::max(fitHeight, fitWidth) + 0.5 * extent.z();
-    const Eigen::Vector3d direction =
-        d == 2 ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(0.35, 0.55, 1.0).normalized();
-    camera.look_at = centre - (d == 2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0, 0.15 * extent.y(), 0));
-    camera.position = camera.look_at + distance * direction;
-  }
-  // The simulator's defaults (sim/solver_defaults.cpp), where the program has the simulator.
-  if (solverDefaults()) solverDefaults()(s);
-}
-
 }  // namespace
-
-Eigen::Array3i latticeCounts(const Scene& scene, const Box& box) {
-  Eigen::Array3i counts(1, 1, 1);
-  for (int k = 0; k < scene.dimensions; ++k) {
-    const double n = std::floor((box.max[k] - box.min[k]) / scene.particle_spacing + 1e-6);
-    counts[k] = static_cast<int>(std::min(std::max(n, 0.0), 2e9));
-  }
-  return counts;
-}
-
-size_t Scene::particleCount() const {
-  size_t total = 0;
-  for (const FluidBlock& fluid : fluids) {
-    const Eigen::Array3i n = latticeCounts(*this, fluid.box);
-    total += size_t(n[0]) * size_t(n[1]) * size_t(n[2]);
-  }
-  return total;
-}
 
 Scene parseScene(const std::string& text, const std::string& where, const std::vector<std::string>& overrides) {
   json root = json::parse(text, nullptr, false);
@@ -606,26 +435,9 @@ Scene parseScene(const std::string& text, const std::string& where, const std::v
   JsonReader reader(root, where, scene, overridden);
   visitScene(scene, reader);
   reader.finish();
-  validate(scene, where);
+  validateScene(scene, where);
   scene.source = where;
   return scene;
-}
-
-SolverDefaults& solverDefaults() {
-  static SolverDefaults resolve = nullptr;
-  return resolve;
-}
-
-std::vector<SolverMethodEntry>& solverMethodCatalog() {
-  static std::vector<SolverMethodEntry> methods;
-  return methods;
-}
-
-std::vector<SolidFiles> solidFiles(const Scene& scene) {
-  std::vector<SolidFiles> solids;
-  for (const ColliderSettings& c : scene.colliders) solids.push_back({c, "colliders", c.motion.size() > 1});
-  for (const BodySettings& b : scene.bodies) solids.push_back({b.solid, "bodies", true});
-  return solids;
 }
 
 Scene loadScene(const fs::path& path, const std::vector<std::string>& overrides) {

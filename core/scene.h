@@ -12,6 +12,8 @@
 
 namespace surge {
 
+class SceneVisitor;  // core/scene_fields.h
+
 struct Box {
   Eigen::Vector3d min = Eigen::Vector3d::Zero();
   Eigen::Vector3d max = Eigen::Vector3d::Zero();
@@ -197,6 +199,7 @@ SolverDefaults& solverDefaults();
 // registry, which fills this list wherever the simulator is linked (sim/fluid_solver.cpp); empty, any name is read.
 struct SolverMethodEntry {
   std::string name, description;
+  void (*declareKeys)(SceneVisitor&, SolverSettings&) = nullptr;  // its own keys under `solver`
 };
 std::vector<SolverMethodEntry>& solverMethodCatalog();
 

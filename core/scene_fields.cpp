@@ -1,33 +1,16 @@
 // Every scene key, declared once. Keep docs/scene-format.md in step by running `surge keys`.
 #include "core/scene_fields.h"
 
+#include <iomanip>
+#include <sstream>
+
 namespace surge {
 namespace {
 
-FieldInfo info(const char* description, const char* units = "") {
-  FieldInfo f;
-  f.description = description;
-  f.units = units;
-  return f;
-}
-FieldInfo required(const char* description, const char* units = "") {
-  FieldInfo f = info(description, units);
-  f.required = true;
-  return f;
-}
-FieldInfo positive(const char* description, const char* units = "", bool isRequired = false) {
-  FieldInfo f = info(description, units);
-  f.min = 0;
-  f.minExclusive = true;
-  f.required = isRequired;
-  return f;
-}
-FieldInfo atLeast(double min, const char* description, const char* units = "", double max = 1e300) {
-  FieldInfo f = info(description, units);
-  f.min = min;
-  f.max = max;
-  return f;
-}
+using field::atLeast;
+using field::info;
+using field::positive;
+using field::required;
 
 void visitBox(SceneVisitor& v, const char* key, Box& box, const char* what) {
   v.group(key, required(what), [&] {
@@ -178,57 +161,19 @@ void visitScene(Scene& s, SceneVisitor& v) {
               atLeast(0, "PBF: time steps per output frame (WCSPH chooses its own, see time_step; DFSPH takes at "
                          "least this many, from its CFL step); 0: 4, or more if the pool the fluid settles into is "
                          "deep enough to need them (dt <= 0.9 particle_spacing / sqrt(g depth))", "", 100000));
-    v.integer("iterations", s.solver.iterations, atLeast(1, "PBF: Jacobi iterations per step", "", 10000));
     v.real("kernel_radius", s.solver.kernel_radius,
            atLeast(0, "SPH kernel radius h; 0 means 2 x particle_spacing", "m"));
     v.real("rest_density", s.solver.rest_density, positive("rest density rho_0", "kg/m^3"));
-    v.real("relaxation_epsilon", s.solver.relaxation_epsilon,
-           atLeast(0, "PBF eq. 11 relaxation epsilon, as a fraction of the rest lattice's sum of squared "
-                      "constraint gradients (0.01 softens the constraint by 1%)"));
-    v.real("warm_start", s.solver.warm_start,
-           atLeast(0, "PBF, experimental: the share of the last step's lambda sums applied as one correction "
-                      "before the Jacobi iterations (a warm start, as DFSPH's); fewer iterations, but it adds "
-                      "kinetic energy to a deep 2D dam break (docs/speed-accuracy.md); 0 turns it off", "", 0.9));
-    static_assert(SolverSettings::kChebyshevLeastIterations == 8, "chebyshev_rho's description names the cap");
-    v.real("chebyshev_rho", s.solver.chebyshev_rho,
-           atLeast(0, "PBF, when iterating to max_density_error with iterations >= 8: the Jacobi iterations' "
-                      "spectral radius that their Chebyshev acceleration assumes (Wang 2015); the larger, the "
-                      "fewer iterations for the same density error, up to where it overshoots (0.95 blows a dam "
-                      "break up; docs/speed-accuracy.md); 0 turns it off", "", 0.95));
     v.real("max_density_error", s.solver.max_density_error,
            atLeast(0, "PBF: when > 0, iterate until the average density error (a fraction) is under it, at most "
                       "`iterations` times; 0 runs exactly `iterations`. DFSPH: its density solver's limit on the "
                       "average predicted compression; 0 means 0.0005"));
-    v.integer("max_iterations", s.solver.max_iterations,
-              atLeast(1, "DFSPH: the most iterations each of its two solvers takes a step", "", 10000));
-    v.real("max_divergence_error", s.solver.max_divergence_error,
-           positive("DFSPH: its divergence solver iterates until the average density change that the "
-                    "velocity divergence would cause over one step (compression only, a fraction) is under it"));
-    v.real("scorr_k", s.solver.scorr_k,
-           atLeast(0, "PBF eq. 13 artificial pressure k, in units of the rest lattice's lambda; 0 turns s_corr off"));
-    v.integer("scorr_n", s.solver.scorr_n, atLeast(1, "PBF eq. 13 exponent n", "", 16));
-    {
-      FieldInfo dq = positive("PBF eq. 13 delta q, as a fraction of the kernel radius (paper: 0.1 to 0.3)");
-      dq.max = 1;
-      v.real("scorr_delta_q", s.solver.scorr_delta_q, dq);
-    }
-    v.real("vorticity_epsilon", s.solver.vorticity_epsilon,
-           atLeast(0, "PBF eq. 16 vorticity confinement epsilon; 0 turns it off", "m/s"));
     v.real("xsph_c", s.solver.xsph_c,
            atLeast(0, "PBF eq. 17 XSPH viscosity c (weights scaled by the particle volume), also DFSPH's; 0 turns "
                       "it off", "", 1));
     v.choice("kernel", s.solver.kernel, {"cubic_spline", "wendland_c2"},
              info("WCSPH and DFSPH smoothing kernel, support kernel_radius: cubic spline (Monaghan 1992) or "
                   "Wendland C2"));
-    v.choice("equation_of_state", s.solver.equation_of_state, {"tait", "linear"},
-             info("WCSPH: tait, p = rho_0 c^2 / 7 ((rho / rho_0)^7 - 1); linear, p = k (rho - rho_0); negative "
-                  "pressures are clamped to 0"));
-    v.real("speed_of_sound", s.solver.speed_of_sound,
-           atLeast(0, "WCSPH speed of sound c; 0 means 10 x the speed of a fall through the tank's height", "m/s"));
-    v.real("gas_constant", s.solver.gas_constant,
-           atLeast(0, "WCSPH linear law's k; 0 means speed_of_sound^2", "m^2/s^2"));
-    v.choice("integrator", s.solver.integrator, {"velocity_verlet", "symplectic_euler"},
-             info("WCSPH time integration: velocity Verlet (kick-drift-kick) or semi-implicit Euler"));
     v.real("time_step", s.solver.time_step,
            atLeast(0, "WCSPH: a fixed step; 0 chooses each step from the CFL condition and the viscous and "
                       "force limits. DFSPH: the largest step (its CFL step may be shorter); 0 means one frame / "
@@ -237,13 +182,8 @@ void visitScene(Scene& s, SceneVisitor& v) {
                              "dt <= cfl particle_spacing / |v|max");
     cfl.max = 1;
     v.real("cfl", s.solver.cfl, cfl);
-    v.real("artificial_viscosity", s.solver.artificial_viscosity,
-           atLeast(0, "WCSPH: Monaghan's artificial viscosity alpha; 0 turns it off"));
-    v.real("kinematic_viscosity", s.solver.kinematic_viscosity,
-           atLeast(0, "WCSPH: laminar viscosity nu (Morris 1997); 0 turns it off", "m^2/s"));
-    v.real("near_pressure", s.solver.near_pressure,
-           atLeast(0, "WCSPH: near-pressure stiffness of Clavet et al. 2005's double density relaxation, as a "
-                      "force; keeps surface particles apart; 0 turns it off", "m^2/s^2"));
+    for (const SolverMethodEntry& method : solverMethodCatalog())
+      if (method.declareKeys) method.declareKeys(v, s.solver);
   });
   v.group("output", info("what the simulator writes"), [&] {
     v.real("fps", s.output.fps, positive("output frames per simulated second (and the video's frame rate)"));
@@ -309,6 +249,41 @@ void visitScene(Scene& s, SceneVisitor& v) {
              info("how the tank is drawn: its edges as thin dark bars, its walls as clear glass (path tracer; the "
                   "preview draws edges), or not at all"));
   });
+}
+
+namespace field {
+
+FieldInfo info(const char* description, const char* units) {
+  FieldInfo f;
+  f.description = description;
+  f.units = units;
+  return f;
+}
+FieldInfo required(const char* description, const char* units) {
+  FieldInfo f = info(description, units);
+  f.required = true;
+  return f;
+}
+FieldInfo positive(const char* description, const char* units, bool isRequired) {
+  FieldInfo f = info(description, units);
+  f.min = 0;
+  f.minExclusive = true;
+  f.required = isRequired;
+  return f;
+}
+FieldInfo atLeast(double min, const char* description, const char* units, double max) {
+  FieldInfo f = info(description, units);
+  f.min = min;
+  f.max = max;
+  return f;
+}
+
+}  // namespace field
+
+std::string formatNumber(double value) {
+  std::ostringstream out;
+  out << std::setprecision(10) << value;
+  return out.str();
 }
 
 }  // namespace surge

@@ -38,7 +38,23 @@ class SceneVisitor {
                     const std::function<void(size_t)>& resize, const std::function<void(size_t)>& visitItem) = 0;
 };
 
-// Visits every key of the scene, in file order.
+// A key's FieldInfo: described (with its units), required, positive, or at least `min` (and at most `max`).
+namespace field {
+FieldInfo info(const char* description, const char* units = "");
+FieldInfo required(const char* description, const char* units = "");
+FieldInfo positive(const char* description, const char* units = "", bool isRequired = false);
+FieldInfo atLeast(double min, const char* description, const char* units = "", double max = 1e300);
+}  // namespace field
+
+// Visits every key of the scene, in file order; a fluid method's own keys under `solver` come from its
+// registration (SolverMethodEntry::declareKeys, core/scene.h), after the keys the methods share.
 void visitScene(Scene& scene, SceneVisitor& visitor);
+
+// A number as the scene's messages and its key table print it (up to 10 significant digits).
+std::string formatNumber(double value);
+
+// Checks a scene just read from `where` and resolves its derived defaults (core/scene_validate.cpp); InputError
+// naming `where` and the key.
+void validateScene(Scene& scene, const std::string& where);
 
 }  // namespace surge

@@ -40,9 +40,12 @@ void makeVideo(const fs::path& dir, const Scene& scene, Progress& progress) {
   // The temporary carries the process id: an ffmpeg left running by a killed `surge` (SIGKILL reaches only surge)
   // may still be writing its own, which must neither mix with this one nor be left behind.
   const std::string partial = "." + scene.name + ".mp4.partial";
-  std::error_code listing;
-  for (const auto& entry : fs::directory_iterator(dir, listing))
-    if (entry.path().filename().string().rfind(partial, 0) == 0) fs::remove(entry.path(), listing);
+  auto removePartials = [&] {
+    std::error_code listing;
+    for (const auto& entry : fs::directory_iterator(dir, listing))
+      if (entry.path().filename().string().rfind(partial, 0) == 0) fs::remove(entry.path(), listing);
+  };
+  removePartials();
   const fs::path temporary = dir / (partial + std::to_string(::getpid()));
   std::ostringstream fps;
   fps << scene.output.fps;
@@ -77,7 +80,12 @@ void makeVideo(const fs::path& dir, const Scene& scene, Progress& progress) {
   ProgramResult result;
   try {
     result = runProgram(ffmpeg, arguments);
-    if (result.exitCode == 0) fs::rename(temporary, video);
+    if (result.exitCode == 0) {
+      fs::rename(temporary, video);
+      // An orphan that was still starting when this run began has opened its temporary since: gone again (an
+      // orphan still writing writes on into the unlinked file).
+      removePartials();
+    }
   } catch (...) {
     std::error_code ignored;
     fs::remove(temporary, ignored);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/parallel.h"
+#include "core/scene_fields.h"
 
 namespace surge {
 namespace {
@@ -298,6 +299,16 @@ FluidMeasures DfsphSolver<Dim>::measure() {
 
 namespace {
 
+// The method's own keys under `solver` (its registration hands them to the scene reader).
+void declareDfsphKeys(SceneVisitor& v, SolverSettings& s) {
+  using field::atLeast, field::info, field::positive;
+  v.integer("max_iterations", s.max_iterations,
+            atLeast(1, "DFSPH: the most iterations each of its two solvers takes a step", "", 10000));
+  v.real("max_divergence_error", s.max_divergence_error,
+         positive("DFSPH: its divergence solver iterates until the average density change that the "
+                  "velocity divergence would cause over one step (compression only, a fraction) is under it"));
+}
+
 // Its solvers move a particle up to about a spacing a step, as PBF's projection does.
 int dfsphPushesPerFrame(const Scene& scene) { return std::max(1, scene.solver.substeps); }
 
@@ -312,7 +323,7 @@ void dfsphDefaults(Scene& scene) {
 // factor, and five more floats and a vector a particle (679 bytes measured at 3.3 million particles).
 const FluidMethod kDfsphMethod = {"dfsph", "Divergence-Free SPH (Bender & Koschier 2015, 2017)",
     &makeMethod<DfsphSolver, 2>, &makeMethod<DfsphSolver, 3>, 360, 800,
-    &dfsphPushesPerFrame, &dfsphDefaults, nullptr};
+    &dfsphPushesPerFrame, &dfsphDefaults, nullptr, &declareDfsphKeys};
 
 template class DfsphSolver<2>;
 template class DfsphSolver<3>;

@@ -23,7 +23,7 @@ std::vector<FluidMethod>& registry() {
 // (core/scene.h).
 bool installInSceneReader() {
   solverDefaults() = &resolveSolverDefaults;
-  for (const FluidMethod& method : registry()) solverMethodCatalog().push_back({method.name, method.description});
+  for (const FluidMethod& method : registry()) solverMethodCatalog().push_back({method.name, method.description, method.declareKeys});
   return true;
 }
 [[maybe_unused]] const bool kInstalled = installInSceneReader();
@@ -41,7 +41,7 @@ void registerFluidMethod(const FluidMethod& method) {
     if (std::string(known.name) == method.name)
       throw std::logic_error(std::string("registerFluidMethod: \"") + method.name + "\" is registered already");
   registry().push_back(method);
-  solverMethodCatalog().push_back({method.name, method.description});
+  solverMethodCatalog().push_back({method.name, method.description, method.declareKeys});
 }
 
 template <int Dim>

@@ -4,8 +4,8 @@
 // solver only through FluidSolver<Dim>. A method is a pair of files (its class deriving from ParticleSolver,
 // sim/particle_solver.h, and its FluidMethod) and one line in the registry (sim/fluid_solver.cpp), or one call
 // of registerFluidMethod for a method outside the library. What the rest of Surge knows of a method it learns
-// from its FluidMethod, never by comparing its name. Its scene keys are declared with the others in
-// core/scene_fields.cpp; `solver.method`'s choices there are the registry's (core/scene.h, solverMethodCatalog).
+// from its FluidMethod, never by comparing its name. Its own scene keys are declared beside it, through
+// its FluidMethod (declareKeys); `solver.method`'s choices are the registry's (core/scene.h, solverMethodCatalog).
 // A method allocates only what its scene turns on, so a scene pays only for what its method uses.
 #pragma once
 
@@ -15,6 +15,7 @@
 
 #include "core/ply.h"
 #include "core/scene.h"
+#include "core/scene_fields.h"
 #include "sim/colliders.h"
 #include "sim/measures.h"
 
@@ -79,6 +80,9 @@ struct FluidMethod {
   void (*resolveDefaults)(Scene&);
   // The notes `surge sim` prints before it starts (a setting the scene may regret); null for none.
   std::vector<std::string> (*notes)(const Scene&);
+  // Declares the method's own keys under `solver` (their defaults, ranges and docs text) to the scene reader,
+  // writer and key table; null for none. Their values live in SolverSettings (core/scene.h).
+  void (*declareKeys)(SceneVisitor&, SolverSettings&);
 };
 
 // FluidMethod::make2 and make3 for a solver class template.

@@ -67,15 +67,9 @@ void initOpenVdb() {
 // method is r - 0.5 h - kZbInset h.
 constexpr double kZbSupport = 2.0;
 constexpr double kZbInset = 0.0;
-// Anisotropic (YT13): kernel support h = 2 spacings, PCA radius 3 spacings (YT13 take 2h; 3 spacings already
-// gives 60 neighbours to a particle of a flat face, above N_epsilon = 25, for a third of the cost), iso-value
-// half the rest field (f = 1 inside a fluid at rest, exactly: AnisotropicKernels::particleVolume; 0.5 is
-// where an unsmoothed half-space of fluid ends), and kAnisoInset: where that surface lies under the fluid's
-// face on the test block (20x10x10, every face), measured. The smoothed centres of the outer layer sit 0.62
-// spacings inside it and their kernels are flattened to 0.8 spacings across, so f = 0.5 lies 0.72 spacings
-// under the fluid's face after the smoothing steps (0.74 before); 0.753 puts the faces within 0.001 spacings
-// of the fluid's (the rest of the 2.7% that the block loses is at its edges and corners, where the centres
-// move inward along two or three axes). The level set is dilated by that much after smoothing.
+// Anisotropic (YT13): kernel support h = 2 spacings, PCA radius 3 spacings (60 neighbours at a flat face, above
+// N_epsilon = 25), iso-value half the rest field, and kAnisoInset: how far that surface lies under the fluid's
+// face, measured on the test block and dilated back after smoothing (docs/performance.md, "Surfacing methods").
 constexpr double kAnisoSupport = 2.0;
 constexpr double kAnisoPca = 3.0;
 constexpr double kAnisoIso = 0.5;

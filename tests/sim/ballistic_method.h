@@ -45,6 +45,6 @@ class BallisticSolver final : public ParticleSolver<Dim> {
 
 inline const FluidMethod kBallisticMethod = {
     "ballistic", "free fall, for the tests", &makeMethod<BallisticSolver, 2>, &makeMethod<BallisticSolver, 3>, 100,
-    200, [](const Scene& scene) { return std::max(1, scene.solver.substeps); }, nullptr, nullptr};
+    200, [](const Scene& scene) { return std::max(1, scene.solver.substeps); }, nullptr, nullptr, nullptr};
 
 }  // namespace surge

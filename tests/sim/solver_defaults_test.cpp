@@ -86,5 +86,32 @@ TEST(SolverDefaults, DocumentationListsEveryKey) {
   EXPECT_NE(doc.find(table), std::string::npos) << "regenerate the table with `surge keys`";
 }
 
+// Every shipped scene loads with every method's keys declared (the methods' own keys are the simulator's).
+TEST(SolverDefaults, ShippedScenesLoad) {
+  for (const auto& entry : fs::directory_iterator(fs::path(SURGE_SOURCE_DIR) / "scenes")) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW(loadScene(entry.path()));
+  }
+}
+
+// A method's own key reads and writes through its registration: scene.json keeps it, and a key no method
+// declares is refused.
+TEST(SolverDefaults, AMethodsOwnKeysRoundTripThroughSceneJson) {
+  const Scene scene =
+      parseScene(kValid, "s", {"solver.iterations=3", "solver.near_pressure=2", "solver.max_iterations=9"});
+  const Scene again = parseScene(sceneToJson(scene), "resolved.json");
+  EXPECT_EQ(again.solver.iterations, 3);
+  EXPECT_DOUBLE_EQ(again.solver.near_pressure, 2);
+  EXPECT_EQ(again.solver.max_iterations, 9);
+  EXPECT_EQ(sceneToJson(again), sceneToJson(scene));
+  try {
+    parseScene(kValid, "s", {"solver.iterations=0"});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "--set: solver.iterations: 0 is out of range (>= 1, <= 10000)");
+  }
+}
+
 }  // namespace
 }  // namespace surge
