@@ -10,24 +10,13 @@ new="${2:?usage: bench_builds.sh OLD_SURGE NEW_SURGE [repeats]}"
 repeats="${3:-3}"
 work="out/bench_builds"
 mkdir -p "$work"
-cat >"$work/peer_dam_break.json" <<'EOF'
-{
-  "name": "peer_dam_break",
-  "dimensions": 3,
-  "domain": {"min": [0, 0, 0], "max": [4, 3, 1.5]},
-  "particle_spacing": 0.025,
-  "fluids": [{"box": {"min": [0, 0, 0], "max": [1, 1, 1]}}],
-  "gravity": [0, -9.81, 0],
-  "solver": {"substeps": 16, "iterations": 100, "max_density_error": 0.0005},
-  "output": {"fps": 30, "frames": 30}
-}
-EOF
 
 # The wall seconds of one run.
 timed() {  # timed SURGE METHOD
   local start end
   start="$(date +%s.%N)"
-  "$1" sim "$work/peer_dam_break.json" --quiet --set solver.method="$2" --out "$work/run_$2" >/dev/null
+  "$1" sim "$(dirname "$0")/../bench/peer_dam_break.json" --quiet --set solver.method="$2" \
+    --out "$work/run_$2" >/dev/null
   end="$(date +%s.%N)"
   echo "$end - $start" | bc -l
 }

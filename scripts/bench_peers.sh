@@ -25,18 +25,6 @@ done
 
 work="out/bench_peers"
 mkdir -p "$work"
-cat >"$work/surge_dam_break.json" <<'EOF'
-{
-  "name": "peer_dam_break",
-  "dimensions": 3,
-  "domain": {"min": [0, 0, 0], "max": [4, 3, 1.5]},
-  "particle_spacing": 0.025,
-  "fluids": [{"box": {"min": [0, 0, 0], "max": [1, 1, 1]}}],
-  "gravity": [0, -9.81, 0],
-  "solver": {"substeps": 16, "iterations": 100, "max_density_error": 0.0005},
-  "output": {"fps": 30, "frames": 30}
-}
-EOF
 
 seconds() {  # the wall time /usr/bin/time -v wrote, in seconds
   sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$1" |
@@ -72,7 +60,7 @@ peer() {  # peer METHOD LABEL
 
 ours() {  # ours METHOD LABEL
   local run="$work/surge_$1"
-  /usr/bin/time -v "$surge" sim "$work/surge_dam_break.json" --quiet --set solver.method="$1" --out "$run" \
+  /usr/bin/time -v "$surge" sim "$(dirname "$0")/../bench/peer_dam_break.json" --quiet --set solver.method="$1" --out "$run" \
     >"$run.out" 2>&1
   awk -F, -v label="$2" -v wall="$(seconds "$run.out")" -v cpu="$(cpu "$run.out")" -v csv="$csv" -v shares="$shares" '
     NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next }

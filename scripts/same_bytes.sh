@@ -11,18 +11,6 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 work="$here/out/same_bytes"
 rm -rf "$work"
 mkdir -p "$work"
-cat >"$work/peer_dam_break.json" <<'EOF'
-{
-  "name": "peer_dam_break",
-  "dimensions": 3,
-  "domain": {"min": [0, 0, 0], "max": [4, 3, 1.5]},
-  "particle_spacing": 0.025,
-  "fluids": [{"box": {"min": [0, 0, 0], "max": [1, 1, 1]}}],
-  "gravity": [0, -9.81, 0],
-  "solver": {"substeps": 16, "iterations": 100, "max_density_error": 0.0005},
-  "output": {"fps": 30, "frames": 30}
-}
-EOF
 
 # stats.csv without the columns that time the run.
 untimed() {
@@ -65,7 +53,7 @@ run_scene() {  # run_scene SCENE METHOD_OVERRIDE...
 }
 
 for scene in "$here"/scenes/*.json; do run_scene "$scene"; done
-run_scene "$work/peer_dam_break.json"
-run_scene "$work/peer_dam_break.json" solver.method=dfsph
-run_scene "$work/peer_dam_break.json" solver.method=wcsph
+run_scene "$here/bench/peer_dam_break.json"
+run_scene "$here/bench/peer_dam_break.json" solver.method=dfsph
+run_scene "$here/bench/peer_dam_break.json" solver.method=wcsph
 exit $failed
