@@ -109,7 +109,7 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   float framePressureMax_ = 0, lastStep_ = 0;
 };
 
-// Its registration (sim/fluid_solver.cpp).
+// Its registration (sim/dfsph_method.cpp), which the registry lists (sim/fluid_solver.cpp).
 extern const FluidMethod kDfsphMethod;
 
 extern template class DfsphSolver<2>;

@@ -1,9 +1,9 @@
 // The one interface every fluid method implements, and the registry that makes the scene's method.
 //
 // The frame loop (sim/simulation.cpp), the rigid bodies' coupling (sim/rigid_bodies.h) and the benchmarks see a
-// solver only through FluidSolver<Dim>. A method is a pair of files (its class deriving from ParticleSolver,
-// sim/particle_solver.h, and its FluidMethod) and one line in the registry (sim/fluid_solver.cpp), or one call
-// of registerFluidMethod for a method outside the library. What the rest of Surge knows of a method it learns
+// solver only through FluidSolver<Dim>. A method is its solver (a class deriving from ParticleSolver,
+// sim/particle_solver.h), its FluidMethod (sim/<method>_method.cpp) and one line in the registry
+// (sim/fluid_solver.cpp), or one call of registerFluidMethod for a method outside the library. What the rest of Surge knows of a method it learns
 // from its FluidMethod, never by comparing its name. Its own scene keys are declared beside it, through
 // its FluidMethod (declareKeys); `solver.method`'s choices are the registry's (core/scene.h, solverMethodCatalog).
 // A method allocates only what its scene turns on, so a scene pays only for what its method uses.

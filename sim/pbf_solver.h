@@ -119,7 +119,7 @@ class PbfSolver final : public ParticleSolver<Dim> {
   int lastIterations_ = 0;
 };
 
-// Its registration (sim/fluid_solver.cpp).
+// Its registration (sim/pbf_method.cpp), which the registry lists (sim/fluid_solver.cpp).
 extern const FluidMethod kPbfMethod;
 
 extern template class PbfSolver<2>;

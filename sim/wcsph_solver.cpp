@@ -5,7 +5,6 @@
 #include <optional>
 
 #include "core/parallel.h"
-#include "core/scene_fields.h"
 
 namespace surge {
 
@@ -219,40 +218,6 @@ FluidMeasures WcsphSolver<Dim>::measure() {
     return this->measureWith([&](float r2) { return kernel.value(std::sqrt(r2)); });
   });
 }
-
-namespace {
-
-// The method's own keys under `solver` (its registration hands them to the scene reader).
-void declareWcsphKeys(SceneVisitor& v, SolverSettings& s) {
-  using field::atLeast, field::info, field::positive;
-  v.choice("equation_of_state", s.equation_of_state, {"tait", "linear"},
-           info("WCSPH: tait, p = rho_0 c^2 / 7 ((rho / rho_0)^7 - 1); linear, p = k (rho - rho_0); negative "
-                "pressures are clamped to 0"));
-  v.real("speed_of_sound", s.speed_of_sound,
-         atLeast(0, "WCSPH speed of sound c; 0 means 10 x the speed of a fall through the tank's height", "m/s"));
-  v.real("gas_constant", s.gas_constant,
-         atLeast(0, "WCSPH linear law's k; 0 means speed_of_sound^2", "m^2/s^2"));
-  v.choice("integrator", s.integrator, {"velocity_verlet", "symplectic_euler"},
-           info("WCSPH time integration: velocity Verlet (kick-drift-kick) or semi-implicit Euler"));
-  v.real("artificial_viscosity", s.artificial_viscosity,
-         atLeast(0, "WCSPH: Monaghan's artificial viscosity alpha; 0 turns it off"));
-  v.real("kinematic_viscosity", s.kinematic_viscosity,
-         atLeast(0, "WCSPH: laminar viscosity nu (Morris 1997); 0 turns it off", "m^2/s"));
-  v.real("near_pressure", s.near_pressure,
-         atLeast(0, "WCSPH: near-pressure stiffness of Clavet et al. 2005's double density relaxation, as a "
-                    "force; keeps surface particles apart; 0 turns it off", "m^2/s^2"));
-}
-
-// The pressure only turns the energy of compression, which the fall gave, back into motion: a spacing a frame, so
-// that a scene with nothing moving (no gravity) still has a runaway speed above zero.
-int wcsphPushesPerFrame(const Scene&) { return 1; }
-
-}  // namespace
-
-// Less than PBF's 400 and 250 bytes a particle (no stored pair factors), counted as those.
-const FluidMethod kWcsphMethod = {"wcsph", "weakly compressible SPH (Monaghan 1994, Becker & Teschner 2007)",
-    &makeMethod<WcsphSolver, 2>, &makeMethod<WcsphSolver, 3>, 250, 400,
-    &wcsphPushesPerFrame, nullptr, nullptr, &declareWcsphKeys};
 
 template class WcsphSolver<2>;
 template class WcsphSolver<3>;

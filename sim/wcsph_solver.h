@@ -78,7 +78,7 @@ class WcsphSolver final : public ParticleSolver<Dim> {
   float framePressureMax_ = 0;
 };
 
-// Its registration (sim/fluid_solver.cpp).
+// Its registration (sim/wcsph_method.cpp), which the registry lists (sim/fluid_solver.cpp).
 extern const FluidMethod kWcsphMethod;
 
 extern template class WcsphSolver<2>;

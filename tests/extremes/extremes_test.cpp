@@ -1,4 +1,4 @@
-// The extremes matrix (issue 7): settings at the edges of what the scene check allows, for both solvers, run as a
+// The extremes matrix (issue 7): settings at the edges of what the scene check allows, for every method, run as a
 // user runs them (`surge sim` in a child process). Each case must end in one of two ways:
 //   - exit 0, every frame 0..output.frames present, all with the scene's particle count, every position and
 //     velocity finite, every position inside the tank and none inside a collider or body, the mechanical energy

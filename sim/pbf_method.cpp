@@ -1,0 +1,63 @@
+// PBF's registration (sim/fluid_solver.h): its own scene keys, the defaults and notes it adds, and what it
+// asks of a scene, beside its solver (sim/pbf_solver.h).
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "core/scene_fields.h"
+#include "sim/pbf_solver.h"
+#include "sim/solver_defaults.h"
+
+namespace surge {
+namespace {
+
+// The method's own keys under `solver` (its registration hands them to the scene reader).
+void declarePbfKeys(SceneVisitor& v, SolverSettings& s) {
+  using field::atLeast, field::info, field::positive;
+  v.integer("iterations", s.iterations, atLeast(1, "PBF: Jacobi iterations per step", "", 10000));
+  v.real("relaxation_epsilon", s.relaxation_epsilon,
+         atLeast(0, "PBF eq. 11 relaxation epsilon, as a fraction of the rest lattice's sum of squared "
+                    "constraint gradients (0.01 softens the constraint by 1%)"));
+  v.real("warm_start", s.warm_start,
+         atLeast(0, "PBF, experimental: the share of the last step's lambda sums applied as one correction "
+                    "before the Jacobi iterations (a warm start, as DFSPH's); fewer iterations, but it adds "
+                    "kinetic energy to a deep 2D dam break (docs/speed-accuracy.md); 0 turns it off", "", 0.9));
+  static_assert(SolverSettings::kChebyshevLeastIterations == 8, "chebyshev_rho's description names the cap");
+  v.real("chebyshev_rho", s.chebyshev_rho,
+         atLeast(0, "PBF, when iterating to max_density_error with iterations >= 8: the Jacobi iterations' "
+                    "spectral radius that their Chebyshev acceleration assumes (Wang 2015); the larger, the "
+                    "fewer iterations for the same density error, up to where it overshoots (0.95 blows a dam "
+                    "break up; docs/speed-accuracy.md); 0 turns it off", "", 0.95));
+  v.real("scorr_k", s.scorr_k,
+         atLeast(0, "PBF eq. 13 artificial pressure k, in units of the rest lattice's lambda; 0 turns s_corr off"));
+  v.integer("scorr_n", s.scorr_n, atLeast(1, "PBF eq. 13 exponent n", "", 16));
+  {
+    FieldInfo dq = positive("PBF eq. 13 delta q, as a fraction of the kernel radius (paper: 0.1 to 0.3)");
+    dq.max = 1;
+    v.real("scorr_delta_q", s.scorr_delta_q, dq);
+  }
+  v.real("vorticity_epsilon", s.vorticity_epsilon,
+         atLeast(0, "PBF eq. 16 vorticity confinement epsilon; 0 turns it off", "m/s"));
+}
+
+// The projection moves a particle up to about a spacing a step (the velocity is that move over the step).
+int pbfPushesPerFrame(const Scene& scene) { return std::max(1, scene.solver.substeps); }
+
+std::vector<std::string> pbfNotes(const Scene& scene) {
+  const int stable = stableSubsteps(scene);
+  if (stable <= scene.solver.substeps) return {};
+  return {"solver.substeps " + std::to_string(scene.solver.substeps) + " is below the " + std::to_string(stable) +
+          " a PBF pool this deep needs to stay at rest (dt <= 0.9 particle_spacing / sqrt(g depth)); leave it out "
+          "to get them"};
+}
+
+}  // namespace
+
+// 400 bytes a particle in 3D: about 340 of channels (x, v, x* and a scratch copy, ids, lambdas, the grid's) and
+// 30 neighbours with their gradient factors, the frame being written, and the allocator's slack; 250 in 2D
+// (docs/performance.md).
+const FluidMethod kPbfMethod = {"pbf", "Position Based Fluids (Macklin & Mueller 2013)",
+    &makeMethod<PbfSolver, 2>, &makeMethod<PbfSolver, 3>, 250, 400,
+    &pbfPushesPerFrame, nullptr, &pbfNotes, &declarePbfKeys};
+
+}  // namespace surge
