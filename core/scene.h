@@ -133,7 +133,7 @@ struct SurfaceSettings {
 };
 
 struct CameraSettings {
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // position == look_at: frame the domain (resolved)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // == look_at: the renderer frames the domain (camera.h)
   Eigen::Vector3d look_at = Eigen::Vector3d::Zero();
   double fov = 40;  // vertical field of view in degrees
 };

@@ -1,6 +1,7 @@
 // Checking a scene once its keys are read (core/scene.h): what the keys' declared ranges cannot say (a box's min
 // below its max, names unique and plain, keyframes in time order, fluid inside the tank), the derived defaults
-// (kernel radius, surface radius and voxel, the camera), and the simulator's, through solverDefaults().
+// (kernel radius, surface radius and voxel), and the simulator's, through solverDefaults(). The camera that frames
+// the domain is the renderer's (render/camera.h, framedCamera).
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -142,21 +143,6 @@ void validateScene(Scene& s, const std::string& where) {
     if (std::max(std::abs(s.domain.min[k]), std::abs(s.domain.max[k])) / surface.voxel_size > double(1 << 22))
       throw InputError(where, "surface.voxel_size", "the domain reaches more than 2^22 voxels from the origin");
 
-  CameraSettings& camera = s.render.camera;
-  if (camera.position == camera.look_at) {
-    // Frame the domain: look at its centre from the front, raised and turned a little (straight on in 2D).
-    const Eigen::Vector3d centre = 0.5 * (s.domain.min + s.domain.max);
-    const Eigen::Vector3d extent = s.domain.max - s.domain.min;
-    const double tanHalf = std::tan(camera.fov * M_PI / 360.0);
-    const double aspect = double(s.render.width) / double(s.render.height);
-    const double fitHeight = 0.5 * extent.y() / tanHalf;
-    const double fitWidth = 0.5 * extent.x() / (tanHalf * aspect);
-    const double distance = 1.4 * std::max(fitHeight, fitWidth) + 0.5 * extent.z();
-    const Eigen::Vector3d direction =
-        d == 2 ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(0.35, 0.55, 1.0).normalized();
-    camera.look_at = centre - (d == 2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0, 0.15 * extent.y(), 0));
-    camera.position = camera.look_at + distance * direction;
-  }
   // The simulator's defaults (sim/solver_defaults.cpp), where the program has the simulator.
   if (solverDefaults()) solverDefaults()(s);
 }

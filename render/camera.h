@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 #include "core/scene.h"
@@ -13,6 +14,26 @@ struct Ray {
   Eigen::Vector3f origin = Eigen::Vector3f::Zero();
   Eigen::Vector3f direction = Eigen::Vector3f::UnitZ();  // unit length
 };
+
+// The scene's camera, or where it leaves position == look_at, one that frames the domain: looking at its centre
+// from the front, raised and turned a little (straight on in 2D), far enough back that the tank fills the image
+// of render.width x render.height with a margin (the quality presets keep that aspect ratio).
+inline CameraSettings framedCamera(const Scene& s) {
+  CameraSettings camera = s.render.camera;
+  if (camera.position != camera.look_at) return camera;
+  const int d = s.dimensions;
+  const Eigen::Vector3d centre = 0.5 * (s.domain.min + s.domain.max);
+  const Eigen::Vector3d extent = s.domain.max - s.domain.min;
+  const double tanHalf = std::tan(camera.fov * M_PI / 360.0);
+  const double aspect = double(s.render.width) / double(s.render.height);
+  const double fitHeight = 0.5 * extent.y() / tanHalf;
+  const double fitWidth = 0.5 * extent.x() / (tanHalf * aspect);
+  const double distance = 1.4 * std::max(fitHeight, fitWidth) + 0.5 * extent.z();
+  const Eigen::Vector3d direction = d == 2 ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(0.35, 0.55, 1.0).normalized();
+  camera.look_at = centre - (d == 2 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(0, 0.15 * extent.y(), 0));
+  camera.position = camera.look_at + distance * direction;
+  return camera;
+}
 
 class PinholeCamera {
  public:

@@ -398,7 +398,7 @@ Rasterizer::Rasterizer(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   Impl& r = *impl_;
   r.scene = scene;
   r.look = Shading::fromScene(scene);
-  r.settings = resolvedRenderSettings(scene.render);
+  r.settings = resolvedRenderSettings(scene);
   r.width = kSupersample * r.settings.width;
   r.height = kSupersample * r.settings.height;
   r.lo = scene.domain.min.cast<float>();

@@ -57,7 +57,7 @@ bool differentSurfaces(const SampleFeatures& a, const SampleFeatures& b) {
 Image traceImage(RenderWorkspace& workspace, const RayDevice& device, const TriangleMesh& water,
                  const std::vector<ColliderMesh>& colliders, const Scene& scene, int frame,
                  const Shading& shading, RenderStats* stats) {
-  const RenderSettings settings = resolvedRenderSettings(scene.render);
+  const RenderSettings settings = resolvedRenderSettings(scene);
   if (settings.width <= 0 || settings.height <= 0)
     throw InputError(scene.name, "render.width", "the image must be at least 1x1 pixels");
   const int width = settings.width, height = settings.height;
@@ -205,6 +205,12 @@ RenderSettings resolvedRenderSettings(const RenderSettings& settings) {
     throw InputError("render.quality",
                      "unknown preset '" + settings.quality + "' (standard, preview, final)");
   }
+  return r;
+}
+
+RenderSettings resolvedRenderSettings(const Scene& scene) {
+  RenderSettings r = resolvedRenderSettings(scene.render);
+  r.camera = framedCamera(scene);
   return r;
 }
 

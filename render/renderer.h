@@ -22,9 +22,11 @@ struct Shading;
 // The settings a `quality` preset stands for: "standard" keeps width, height, samples and max_depth;
 // "preview" halves the resolution (at least 16 pixels) and uses 4 samples and depth 4; "final" scales the
 // resolution up to at least 720 pixels high (1280x720 for the default 16:9) with at least 64 samples and
-// depth 12. The camera is the scene's either way (its framing depends only on the aspect ratio, which the
-// presets keep).
+// depth 12. The camera is the settings' either way.
 RenderSettings resolvedRenderSettings(const RenderSettings& settings);
+// The scene's render settings so resolved, with the camera that frames the domain where the scene sets none
+// (framedCamera, render/camera.h: its framing depends only on the aspect ratio, which the presets keep).
+RenderSettings resolvedRenderSettings(const Scene& scene);
 
 // What a render cost, for the benchmark.
 struct RenderStats {

@@ -218,7 +218,7 @@ RayScene::RayScene(const RayDevice& device, const TriangleMesh& water, const Sce
     attachTriangles(dev.device, impl_->scene, kWaterId, kSeen | kCastsShadow, water.positions,
                     water.triangles);
   impl_->colliders = &colliders;
-  const Eigen::Vector3f camera = scene.render.camera.position.cast<float>();
+  const Eigen::Vector3f camera = framedCamera(scene).position.cast<float>();
   for (size_t c = 0; c < colliders.size(); ++c) {
     impl_->colliderTriangles.push_back(trianglesFacing(colliders[c], camera));
     if (impl_->colliderTriangles.back().empty()) continue;

@@ -76,7 +76,7 @@ Image renderFrame(const fs::path& dir, const std::string& renderer, int frame) {
 
 // The pixel where a world point lands in an image of the scene's camera.
 const uint8_t* pixelOf(const Image& image, const Scene& scene, const Vector3f& point) {
-  const PinholeCamera camera(scene.render.camera, image.width, image.height);
+  const PinholeCamera camera(framedCamera(scene), image.width, image.height);
   float x = 0, y = 0;
   EXPECT_TRUE(camera.project(point, x, y));
   EXPECT_TRUE(x >= 0 && x < image.width && y >= 0 && y < image.height) << x << "," << y;

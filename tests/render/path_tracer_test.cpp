@@ -64,7 +64,7 @@ TEST(PathTracerTest, WhiteFurnaceConservesEnergy) {
   const RayDevice device;
   const TriangleMesh ball = sphereMesh({0.5f, 0.4f, 0.5f}, 0.25f, 24);
   const RayScene world(device, ball, scene);
-  const PinholeCamera camera(scene.render.camera, 64, 48);
+  const PinholeCamera camera(framedCamera(scene), 64, 48);
   float cx = 0, cy = 0;
   ASSERT_TRUE(camera.project({0.5f, 0.4f, 0.5f}, cx, cy));
   // Rays onto the ground beside the tank (one Lambertian bounce into the sky), through the water ball
@@ -86,7 +86,7 @@ TEST(PathTracerTest, GlassWallsAndCollidersConserveEnergyInTheWhiteFurnace) {
   const std::vector<ColliderMesh> colliders = {
       makeColliderMesh(white, testing::boxMeshWithFaceNormals({0.8f, 0.0f, 0.2f}, {0.95f, 0.3f, 0.8f}))};
   const RayScene world(device, ball, scene, colliders);
-  const PinholeCamera camera(scene.render.camera, 64, 48);
+  const PinholeCamera camera(framedCamera(scene), 64, 48);
   float cx = 0, cy = 0, bx = 0, by = 0;
   ASSERT_TRUE(camera.project({0.5f, 0.4f, 0.5f}, cx, cy));
   ASSERT_TRUE(camera.project({0.875f, 0.3f, 0.5f}, bx, by));
@@ -144,7 +144,7 @@ TEST(PathTracerTest, WaterBallOverTheCheckerboardActsAsALens) {
   const float radius = 0.15f;
   const Eigen::Vector3f centre(1.0f, 0.55f, 0.5f);
   const Image image = renderMeshWith(sphereMesh(centre, radius, 32), scene, 0, shading);
-  const PinholeCamera camera(scene.render.camera, image.width, image.height);
+  const PinholeCamera camera(framedCamera(scene), image.width, image.height);
   float cx = 0, cy = 0;
   ASSERT_TRUE(camera.project(centre, cx, cy));
   float rimX = 0, rimY = 0;
@@ -217,6 +217,35 @@ TEST(PathTracerTest, QualityPresetsSetResolutionAndSamples) {
   const Image image = renderMesh(TriangleMesh{}, scene, 0);
   EXPECT_EQ(image.width, 50);
   EXPECT_EQ(image.height, 30);
+}
+
+// A scene that sets no camera is framed by the renderer: the whole tank in view, its centre near the image's,
+// at any quality (the presets keep the aspect ratio); a camera the scene sets is kept as it is.
+TEST(PathTracerTest, ASceneWithoutACameraIsFramedWholeInView) {
+  const Scene scene = unitTankScene();
+  ASSERT_EQ(scene.render.camera.position, scene.render.camera.look_at);  // the scene leaves it to the renderer
+  for (const char* quality : {"standard", "preview", "final"}) {
+    SCOPED_TRACE(quality);
+    Scene preset = scene;
+    preset.render.quality = quality;
+    const RenderSettings settings = resolvedRenderSettings(preset);
+    EXPECT_EQ(settings.camera.position, framedCamera(scene).position);
+    const PinholeCamera camera(settings.camera, settings.width, settings.height);
+    for (int corner = 0; corner < 8; ++corner) {
+      Eigen::Vector3d p;
+      for (int k = 0; k < 3; ++k) p[k] = (corner >> k & 1) ? scene.domain.max[k] : scene.domain.min[k];
+      float x = -1, y = -1;
+      ASSERT_TRUE(camera.project(p.cast<float>(), x, y));
+      EXPECT_GT(x, 0);
+      EXPECT_LT(x, settings.width);
+      EXPECT_GT(y, 0);
+      EXPECT_LT(y, settings.height);
+    }
+  }
+  Scene placed = scene;
+  placed.render.camera.position = Eigen::Vector3d(3, 2, 5);
+  EXPECT_EQ(framedCamera(placed).position, Eigen::Vector3d(3, 2, 5));
+  EXPECT_EQ(framedCamera(placed).look_at, scene.render.camera.look_at);
 }
 
 }  // namespace

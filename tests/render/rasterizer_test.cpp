@@ -26,7 +26,7 @@ TEST(RasterizerTest, DrawsTheWaterWhereTheMeshProjects) {
   ASSERT_EQ(water.width, 64);
   ASSERT_EQ(water.height, 48);
   ASSERT_EQ(water.rgb.size(), 64u * 48u * 3u);
-  const PinholeCamera camera(scene.render.camera, 64, 48);
+  const PinholeCamera camera(framedCamera(scene), 64, 48);
   float px = 0, py = 0;
   ASSERT_TRUE(camera.project({0.5f, 0.5f, 0.5f}, px, py));
   const uint8_t *w = pixelAt(water, int(px), int(py)), *e = pixelAt(empty, int(px), int(py));

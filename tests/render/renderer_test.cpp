@@ -63,7 +63,7 @@ TEST(RendererTest, WaterColouredPixelsWhereTheMeshProjects) {
   const Scene scene = unitTankScene();
   const Image water = renderMesh(boxMesh({0.3f, 0.0f, 0.3f}, {0.7f, 0.5f, 0.7f}), scene, 0);
   const Image empty = renderMesh(TriangleMesh{}, scene, 0);
-  const PinholeCamera camera(scene.render.camera, scene.render.width, scene.render.height);
+  const PinholeCamera camera(framedCamera(scene), scene.render.width, scene.render.height);
   // The centre of the box's top face; the default camera looks down on it from above, so the 3x3 pixels
   // around its projection lie inside the top face (which spans about 8x7 pixels around it).
   float px = 0, py = 0;
