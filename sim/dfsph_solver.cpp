@@ -24,7 +24,7 @@ constexpr float kRelaxation = 0.5f;
 
 template <int Dim>
 DfsphSolver<Dim>::DfsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes)
-    : Core(scene, std::move(shapes), makeSphTankWalls<Dim>(scene), sphParticleMass<Dim>(scene)),
+    : Core(scene, std::move(shapes), sphRestLattice<Dim>(scene)),
       kernel_(sphKernel<Dim>(scene)) {
   const SolverSettings& s = scene.solver;
   support_ = static_cast<float>(s.kernel_radius);

@@ -5,39 +5,24 @@
 namespace surge {
 
 template <int Dim>
-TankWalls<Dim> makeSphTankWalls(const Scene& scene) {
-  const float spacing = static_cast<float>(scene.particle_spacing);
-  const Vec<Dim> lo = toVec<Dim>(scene.domain.min), hi = toVec<Dim>(scene.domain.max);
+RestLattice<Dim> sphRestLattice(const Scene& scene) {
   return sphKernel<Dim>(scene).visit([&](const auto& kernel) {
-    return TankWalls<Dim>(
-        lo, hi, spacing, kernel.radius(), [&](const Vec<Dim>& r) { return kernel.value(r.norm()); },
+    return RestLattice<Dim>(
+        scene, kernel.radius(), [&](const Vec<Dim>& r) { return kernel.value(r.norm()); },
         [&](const Vec<Dim>& r) -> Vec<Dim> { return kernel.gradientFactor(r.norm()) * r; });
   });
 }
 
 template <int Dim>
-float sphParticleMass(const Scene& scene) {
-  double weightSum = 0, unused = 0;
-  sphKernel<Dim>(scene).visit([&](const auto& kernel) {
-    latticeSums<Dim>(static_cast<float>(scene.particle_spacing), kernel.radius(),
-                     [&](const Vec<Dim>& r) { return kernel.value(r.norm()); },
-                     [&](const Vec<Dim>& r) -> Vec<Dim> { return kernel.gradientFactor(r.norm()) * r; },
-                     &weightSum, &unused);
-    return 0;
-  });
-  return static_cast<float>(scene.solver.rest_density / weightSum);
-}
-
-template <int Dim>
 ParticleSolver<Dim>::ParticleSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes,
-                                    TankWalls<Dim> walls, float mass)
+                                    RestLattice<Dim> lattice)
     : restDensity_(static_cast<float>(scene.solver.rest_density)),
-      mass_(mass),
+      mass_(static_cast<float>(scene.solver.rest_density / lattice.weightSum)),
       gravity_(toVec<Dim>(scene.gravity)),
       attractor_(scene.attractor),
       grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
             NeighborGrid<Dim>::cellSizeFor(static_cast<float>(scene.solver.kernel_radius))),
-      walls_(std::move(walls)),
+      walls_(std::move(lattice.walls)),
       sceneSpeedLimit_(static_cast<float>(runawaySpeed(scene))) {
   if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
 }
@@ -79,10 +64,8 @@ size_t ParticleSolver<Dim>::coreMemoryBytes() const {
   return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes();
 }
 
-template TankWalls<2> makeSphTankWalls<2>(const Scene&);
-template TankWalls<3> makeSphTankWalls<3>(const Scene&);
-template float sphParticleMass<2>(const Scene&);
-template float sphParticleMass<3>(const Scene&);
+template RestLattice<2> sphRestLattice<2>(const Scene&);
+template RestLattice<3> sphRestLattice<3>(const Scene&);
 template class ParticleSolver<2>;
 template class ParticleSolver<3>;
 

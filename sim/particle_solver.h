@@ -35,14 +35,27 @@ SphKernel<Dim> sphKernel(const Scene& scene) {
   return SphKernel<Dim>(scene.solver.kernel, static_cast<float>(scene.solver.kernel_radius));
 }
 
-// The tank's walls seen through the scene's SPH kernel.
+// The rest lattice of the scene's spacing seen through a method's kernel, given by W and grad W as functions of
+// the offset r with support `radius`: the tank's walls (the lattice continued beyond them) and the lattice sums
+// of W and |grad W|^2 around an interior particle, which set the particle mass (the rest lattice has exactly
+// rest_density) and PBF's constraint scale.
 template <int Dim>
-TankWalls<Dim> makeSphTankWalls(const Scene& scene);
+struct RestLattice {
+  TankWalls<Dim> walls;
+  double weightSum = 0, gradientSquaredSum = 0;
 
-// The particle mass that gives the rest lattice of the scene's spacing exactly rest_density with the scene's SPH
-// kernel (PBF's, with poly6, is in its solver).
+  template <typename Weight, typename Gradient>
+  RestLattice(const Scene& scene, float radius, Weight weight, Gradient gradient)
+      : walls(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max), static_cast<float>(scene.particle_spacing),
+              radius, weight, gradient) {
+    latticeSums<Dim>(static_cast<float>(scene.particle_spacing), radius, weight, gradient, &weightSum,
+                     &gradientSquaredSum);
+  }
+};
+
+// The rest lattice through the scene's SPH kernel (WCSPH, DFSPH).
 template <int Dim>
-float sphParticleMass(const Scene& scene);
+RestLattice<Dim> sphRestLattice(const Scene& scene);
 
 template <int Dim>
 class ParticleSolver : public FluidSolver<Dim> {
@@ -65,9 +78,9 @@ class ParticleSolver : public FluidSolver<Dim> {
   const Colliders<Dim>& colliders() const { return colliders_; }
 
  protected:
-  // `walls`: the tank seen through the method's kernel; `mass`: the particle mass that gives the rest lattice
-  // exactly rest_density with that kernel. `shapes`: the scene's collider shapes, null builds them.
-  ParticleSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, TankWalls<Dim> walls, float mass);
+  // `lattice`: the rest lattice through the method's kernel, whose walls become the tank and whose weight sum the
+  // particle mass. `shapes`: the scene's collider shapes, null builds them.
+  ParticleSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, RestLattice<Dim> lattice);
 
   // The method's own channels, sized for the n particles setParticles was given.
   virtual void resizeChannels(size_t n) = 0;

@@ -24,23 +24,13 @@ inline float integerPower(float x, int n) {
 // may differ in the last bits), never on the thread count. A pair closer than coincidentLength_ (see
 // coincidentOffset) is rare; its particle is done again by the scalar loop beside.
 
-// The rest lattice's sums of poly6 and of the squared spiky gradient (eq. 2 and 8-9 over the lattice).
+// The rest lattice through poly6 (eq. 2) and the spiky gradient (eq. 8).
 template <int Dim>
-struct LatticeSums {
-  double weight = 0, gradientSquared = 0;
-  LatticeSums(const Scene& scene, const Kernels<Dim>& kernels) {
-    latticeSums<Dim>(static_cast<float>(scene.particle_spacing), kernels.radius(),
-                     [&](const Vec<Dim>& r) { return kernels.poly6(r.squaredNorm()); },
-                     [&](const Vec<Dim>& r) { return kernels.spikyGradient(r, r.norm()); }, &weight, &gradientSquared);
-  }
-};
-
-template <int Dim>
-TankWalls<Dim> pbfTankWalls(const Scene& scene, const Kernels<Dim>& kernels) {
-  return TankWalls<Dim>(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
-                        static_cast<float>(scene.particle_spacing), kernels.radius(),
-                        [&](const Vec<Dim>& r) { return kernels.poly6(r.squaredNorm()); },
-                        [&](const Vec<Dim>& r) { return kernels.spikyGradient(r, r.norm()); });
+RestLattice<Dim> pbfRestLattice(const Scene& scene) {
+  const Kernels<Dim> kernels(static_cast<float>(scene.solver.kernel_radius));
+  return RestLattice<Dim>(
+      scene, kernels.radius(), [&](const Vec<Dim>& r) { return kernels.poly6(r.squaredNorm()); },
+      [&](const Vec<Dim>& r) { return kernels.spikyGradient(r, r.norm()); });
 }
 
 }  // namespace
@@ -49,17 +39,19 @@ TankWalls<Dim> pbfTankWalls(const Scene& scene, const Kernels<Dim>& kernels) {
 // so a block at rest starts unstressed and keeps its volume N x spacing^d.
 template <int Dim>
 PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes)
-    : Core(scene, std::move(shapes), pbfTankWalls<Dim>(scene, Kernels<Dim>(float(scene.solver.kernel_radius))),
-           static_cast<float>(scene.solver.rest_density /
-                              LatticeSums<Dim>(scene, Kernels<Dim>(float(scene.solver.kernel_radius))).weight)),
-      kernels_(static_cast<float>(scene.solver.kernel_radius)) {
+    : PbfSolver(scene, std::move(shapes), pbfRestLattice<Dim>(scene)) {}
+
+template <int Dim>
+PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes,
+                          RestLattice<Dim> lattice)
+    : Core(scene, std::move(shapes), lattice), kernels_(static_cast<float>(scene.solver.kernel_radius)) {
   substeps_ = scene.solver.substeps;
   const SolverSettings& s = scene.solver;
   const float spacing = static_cast<float>(scene.particle_spacing);
   massOverRho_ = mass_ / restDensity_;
   // sum_k |grad_k C_i|^2 at the rest lattice (eq. 8-9 with C_i = rho_i / rho_0 - 1): the scale of eq. 11's
   // denominator. epsilon is a fraction of it, s_corr is measured in lambda's units 1 / that sum.
-  latticeGradientSum_ = static_cast<float>(massOverRho_ * massOverRho_ * LatticeSums<Dim>(scene, kernels_).gradientSquared);
+  latticeGradientSum_ = static_cast<float>(massOverRho_ * massOverRho_ * lattice.gradientSquaredSum);
   epsilon_ = static_cast<float>(s.relaxation_epsilon) * latticeGradientSum_;
   coincidentLength_ = 1e-4f * kernels_.radius();
   scorrK_ = static_cast<float>(s.scorr_k);

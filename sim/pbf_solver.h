@@ -59,6 +59,8 @@ class PbfSolver final : public ParticleSolver<Dim> {
 
  private:
   using Core = ParticleSolver<Dim>;
+  // Delegated to by the one above, with the rest lattice through PBF's kernels.
+  PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, RestLattice<Dim> lattice);
   using Core::x_, Core::v_, Core::neighbors_, Core::walls_, Core::colliders_, Core::mass_, Core::times_;
   using Core::vectorScratch_, Core::restDensity_;
 

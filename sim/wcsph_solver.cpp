@@ -11,7 +11,7 @@ namespace surge {
 // The mass gives the rest lattice exactly rho_0 (the same choice as PBF's, with this kernel).
 template <int Dim>
 WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes)
-    : Core(scene, std::move(shapes), makeSphTankWalls<Dim>(scene), sphParticleMass<Dim>(scene)),
+    : Core(scene, std::move(shapes), sphRestLattice<Dim>(scene)),
       verlet_(scene.solver.integrator == "velocity_verlet"),
       tait_(scene.solver.equation_of_state == "tait"),
       kernel_(sphKernel<Dim>(scene)) {

@@ -14,7 +14,7 @@ template <int Dim>
 class BallisticSolver final : public ParticleSolver<Dim> {
  public:
   explicit BallisticSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes = nullptr)
-      : ParticleSolver<Dim>(scene, std::move(shapes), makeSphTankWalls<Dim>(scene), sphParticleMass<Dim>(scene)),
+      : ParticleSolver<Dim>(scene, std::move(shapes), sphRestLattice<Dim>(scene)),
         kernel_(sphKernel<Dim>(scene)),
         substeps_(scene.solver.substeps) {}
 

@@ -162,7 +162,7 @@ TEST(Colliders, BoxCountsTheLatticeInsideItExactly) {
       EXPECT_NEAR((colliders.hydrostaticSum(0, p, d, n, gravity) - exactHydrostatic).norm(), 0.0,
                   1e-4 * interior * 9.81) << c.where;
     float flatWeight, flatGradient;
-    makeSphTankWalls<3>(scene).flatWall().lookup(d, flatWeight, flatGradient);
+    sphRestLattice<3>(scene).walls.flatWall().lookup(d, flatWeight, flatGradient);
     std::printf("%-32s weight %.4f of the interior sum (exact %.4f, a flat wall at the nearest point %.4f)\n",
                 c.where, weight / interior, exactWeight / interior, flatWeight / interior);
   }
