@@ -106,7 +106,7 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
     for (const auto& entry : fs::recursive_directory_iterator(dir / sub, error))
       if (entry.is_regular_file(error)) freed += double(entry.file_size(error));
   }
-  checkFreeSpace(dir, "--out", double(framesLeft) * (28.0 * double(scene.particleCount()) + 512.0) - freed,
+  checkFreeSpace(dir, "--out", double(framesLeft) * (28.0 * double(mostParticles(scene)) + 512.0) - freed,
                  std::to_string(framesLeft) + " particle frames");
   checkOutputFolder(dir);
   if (!resume) removeLaterStagesFrames(dir);

@@ -122,6 +122,26 @@ class JsonReader : public SceneVisitor {
     }
   }
 
+  void choices(const char* key, std::vector<std::string>& values, const std::vector<std::string>& options,
+               const FieldInfo& info) override {
+    if (const json* j = find(key, info)) {
+      if (!j->is_array()) fail(key, "expected an array of names, got " + describe(*j));
+      values.clear();
+      for (const json& item : *j) {
+        failIfNonFinite(key, item);
+        if (!item.is_string()) fail(key, "expected names, got " + describe(*j));
+        const std::string name = item.get<std::string>();
+        if (std::find(options.begin(), options.end(), name) == options.end()) {
+          std::string list;
+          for (const std::string& option : options) list += (list.empty() ? "" : ", ") + option;
+          fail(key, "'" + name + "' is not one of: " + list);
+        }
+        if (std::find(values.begin(), values.end(), name) != values.end()) fail(key, "'" + name + "' is named twice");
+        values.push_back(name);
+      }
+    }
+  }
+
   void integer(const char* key, int& value, const FieldInfo& info) override {
     if (const json* j = find(key, info)) {
       failIfNonFinite(key, *j);
@@ -262,6 +282,10 @@ class JsonWriter : public SceneVisitor {
   void choice(const char* key, std::string& value, const std::vector<std::string>&, const FieldInfo&) override {
     (*stack_.back())[key] = value;
   }
+  void choices(const char* key, std::vector<std::string>& values, const std::vector<std::string>&,
+               const FieldInfo&) override {
+    (*stack_.back())[key] = values;
+  }
   void integer(const char* key, int& value, const FieldInfo&) override { (*stack_.back())[key] = value; }
   void real(const char* key, double& value, const FieldInfo&) override { (*stack_.back())[key] = value; }
   void vector(const char* key, Eigen::Vector3d& value, const FieldInfo&, bool always3) override {
@@ -308,6 +332,12 @@ class KeyTable : public SceneVisitor {
     std::string list;
     for (const std::string& option : options) list += (list.empty() ? "" : ", ") + ("`" + option + "`");
     row(key, "string", "\"" + value + "\"", info, "one of " + list);
+  }
+  void choices(const char* key, std::vector<std::string>&, const std::vector<std::string>& options,
+               const FieldInfo& info) override {
+    std::string list;
+    for (const std::string& option : options) list += (list.empty() ? "" : ", ") + ("`" + option + "`");
+    row(key, "array of strings", "[]", info, "each one of " + list);
   }
   void integer(const char* key, int& value, const FieldInfo& info) override {
     row(key, "integer", std::to_string(value), info);

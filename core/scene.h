@@ -19,10 +19,11 @@ struct Box {
   Eigen::Vector3d max = Eigen::Vector3d::Zero();
 };
 
-struct FluidBlock {
-  Box box;
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-};
+// The tank's faces by name, in this order (2D: the first four).
+inline const std::vector<std::string>& tankFaceNames() {
+  static const std::vector<std::string> names = {"-x", "+x", "-y", "+y", "-z", "+z"};
+  return names;
+}
 
 struct SolverSettings {
   std::string method = "pbf";
@@ -116,6 +117,43 @@ struct BodySettings {
   double restitution = 0.1;
 };
 
+// A block of fluid at t = 0: a box, or a solid of the bodies' shapes placed as a collider is (`solid.shape`
+// empty: the box). Every lattice site inside it is filled (sim/simulation.h, initialParticles).
+struct FluidBlock {
+  Box box;
+  ColliderSettings solid = shapeless();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+
+  bool shaped() const { return !solid.shape.empty(); }
+  static ColliderSettings shapeless() {
+    ColliderSettings c;
+    c.shape.clear();
+    return c;
+  }
+};
+
+struct EmitterKeyframe {
+  double time = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // zero: the emitter's direction
+  double speed = -1;                                    // negative: the emitter's speed
+};
+
+// Where fluid enters (sim/sources.h): layers of particles leave a disc (a segment in 2D) or a rectangle, along
+// `direction` at `speed`, from `start` until `stop`; a keyframe may move it, turn it and change its speed.
+struct EmitterSettings {
+  std::string name;  // empty in the file: "emitter<i>" (resolved)
+  std::string shape = "disc";
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  double radius = 0.05;
+  std::vector<double> size;  // rectangle: [width, height]
+  double speed = 1;
+  double start = 0;
+  double stop = 0;  // 0: never
+  std::vector<EmitterKeyframe> motion;
+};
+
 struct OutputSettings {
   double fps = 30;
   int frames = 90;
@@ -162,12 +200,15 @@ struct Scene {
   std::string name;
   int dimensions = 3;
   Box domain;
+  std::vector<std::string> open;  // domain.open: tank faces that are not walls (tankFaceNames)
   double particle_spacing = 0;
   std::vector<FluidBlock> fluids;
   Eigen::Vector3d gravity = Eigen::Vector3d(0, -9.81, 0);
   AttractorSettings attractor;
   std::vector<ColliderSettings> colliders;
   std::vector<BodySettings> bodies;
+  std::vector<EmitterSettings> emitters;
+  std::vector<ColliderSettings> sinks;  // shapes that remove the particles entering them
   SolverSettings solver;
   OutputSettings output;
   SurfaceSettings surface;
@@ -176,8 +217,11 @@ struct Scene {
   // The scene file it was read from (not a key): collider files are found beside it, errors name it.
   std::string source;
 
-  // Particles the fluid boxes hold on the lattice of particle_spacing.
+  // Particles the fluid boxes hold on the lattice of particle_spacing (shaped fluids not counted: the simulator
+  // fills them, initialParticles in sim/simulation.h).
   size_t particleCount() const;
+  // True when fluid can enter or leave: emitters, sinks or open faces.
+  bool hasSources() const { return !emitters.empty() || !sinks.empty() || !open.empty(); }
 };
 
 // A collider or a body as the simulation left it for the later stages: its mesh in the world at time 0 in

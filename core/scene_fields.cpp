@@ -13,7 +13,7 @@ using field::positive;
 using field::required;
 
 void visitBox(SceneVisitor& v, const char* key, Box& box, const char* what) {
-  v.group(key, required(what), [&] {
+  v.group(key, info(what), [&] {
     v.vector("min", box.min, required("lower corner", "m"));
     v.vector("max", box.max, required("upper corner", "m"));
   });
@@ -87,6 +87,53 @@ void visitSolid(SceneVisitor& v, ColliderSettings& c, bool body) {
   v.integer("visible", c.visible, atLeast(0, "0: simulated but not drawn", "", 1));
 }
 
+// The shape keys a fluid block and a sink take: a solid of the collider vocabulary and its placement.
+void visitShapeKeys(SceneVisitor& v, ColliderSettings& c, bool sink) {
+  if (sink)
+    v.text("name", c.name, info("a name for messages (letters, digits, -, _, .); empty: sink<i>"));
+  v.text("shape", c.shape,
+         sink ? required("plane (a half-space), box, sphere, capsule, cylinder (along local y), heightfield or mesh "
+                         "(OBJ or PLY): particles inside it are removed")
+              : info("instead of `box`: box, sphere, capsule, cylinder (along local y) or mesh (a closed OBJ or "
+                     "PLY, 3D), every lattice site inside it filled"));
+  v.vector("position", c.position, info("the shape's centre (a mesh's origin)", "m"));
+  visitRotation(v, c.rotation);
+  v.real("scale", c.scale, positive("uniform scale of the shape about its position"));
+  v.reals("size", c.size, info(sink ? "box: full extents; heightfield: [x, z] extents" : "box: full extents", "m"));
+  v.real("radius", c.radius, positive("sphere, capsule and cylinder radius", "m"));
+  v.real("height", c.height, positive("capsule and cylinder: length along local y", "m"));
+  if (sink) v.vector("normal", c.normal, info("plane: the normal, pointing out of the sink (any length but 0)"));
+  v.text("file", c.file, info("mesh: an OBJ or PLY (closed, for a fluid); heightfield: a PNG; relative to the scene "
+                              "file"));
+}
+
+void visitEmitter(SceneVisitor& v, EmitterSettings& e) {
+  v.text("name", e.name, info("a name for messages (letters, digits, -, _, .); empty: emitter<i>"));
+  v.choice("shape", e.shape, {"disc", "rectangle"},
+           info("disc: a disc of `radius` across `direction` (in 2D a segment of length 2 radius); rectangle (3D): "
+                "`size` [width, height], width along direction x up (x when direction is vertical), height across "
+                "both"));
+  v.vector("position", e.position, required("the centre of the emitting face", "m"));
+  v.vector("direction", e.direction, required("the direction particles leave in (any length but 0)"));
+  v.real("radius", e.radius, positive("disc: its radius (2D: half the segment's length)", "m"));
+  v.reals("size", e.size, info("rectangle: [width, height]", "m"));
+  v.real("speed", e.speed, atLeast(0, "the speed particles leave at; the volume flux is area x speed", "m/s"));
+  v.real("start", e.start, atLeast(0, "when it opens", "s"));
+  v.real("stop", e.stop, atLeast(0, "when it closes; 0: never", "s"));
+  v.list(
+      "motion", info("keyframes of position, direction and speed, linearly interpolated (held before the first "
+                     "and after the last); empty: it stands still"),
+      [&] { return e.motion.size(); }, [&](size_t n) { e.motion.resize(n); },
+      [&](size_t i) {
+        EmitterKeyframe& k = e.motion[i];
+        v.real("time", k.time, atLeast(0, "time of the keyframe", "s"));
+        v.vector("position", k.position, required("position at that time", "m"));
+        v.vector("direction", k.direction, info("direction at that time; zero (the default): the emitter's"));
+        v.real("speed", k.speed, info("speed at that time (0 closes it until a later keyframe opens it); "
+                                      "negative (the default): the emitter's", "m/s"));
+      });
+}
+
 void visitBody(SceneVisitor& v, BodySettings& b) {
   visitSolid(v, b.solid, true);
   v.real("density", b.density,
@@ -112,15 +159,23 @@ void visitScene(Scene& s, SceneVisitor& v) {
     dims.max = 3;
     v.integer("dimensions", s.dimensions, dims);
   }
-  visitBox(v, "domain", s.domain, "the tank: an axis-aligned box whose walls are solid");
+  v.group("domain", required("the tank: an axis-aligned box whose walls are solid"), [&] {
+    v.vector("min", s.domain.min, required("lower corner", "m"));
+    v.vector("max", s.domain.max, required("upper corner", "m"));
+    v.choices("open", s.open, tankFaceNames(),
+              info("faces that are not walls (2D: -x, +x, -y, +y): a particle crossing one is removed, and the "
+                   "renders leave it out"));
+  });
   v.real("particle_spacing", s.particle_spacing,
          positive("initial lattice spacing; the particle radius is half of it", "m", true));
   v.list(
-      "fluids", required("blocks of fluid, each filled with particles on the lattice"),
+      "fluids", info("blocks of fluid at the start, each filled with particles on the lattice (none: the "
+                     "emitters bring it)"),
       [&] { return s.fluids.size(); }, [&](size_t n) { s.fluids.resize(n); },
       [&](size_t i) {
         FluidBlock& f = s.fluids[i];
-        visitBox(v, "box", f.box, "the block, filled with particles at cell centres of the lattice");
+        visitBox(v, "box", f.box, "the block, filled with particles at cell centres of the lattice; or give a shape");
+        visitShapeKeys(v, f.solid, false);
         v.vector("velocity", f.velocity, info("initial velocity", "m/s"));
       });
   v.vector("gravity", s.gravity, info("gravitational acceleration", "m/s^2"));
@@ -146,6 +201,13 @@ void visitScene(Scene& s, SceneVisitor& v) {
                      "and the tank (Bullet)"),
       [&] { return s.bodies.size(); }, [&](size_t n) { s.bodies.resize(n); },
       [&](size_t i) { visitBody(v, s.bodies[i]); });
+  v.list(
+      "emitters", info("where fluid flows in: layers of particles leaving a disc or a rectangle (sim/sources.h)"),
+      [&] { return s.emitters.size(); }, [&](size_t n) { s.emitters.resize(n); },
+      [&](size_t i) { visitEmitter(v, s.emitters[i]); });
+  v.list(
+      "sinks", info("shapes that remove every particle entering them"), [&] { return s.sinks.size(); },
+      [&](size_t n) { s.sinks.resize(n); }, [&](size_t i) { visitShapeKeys(v, s.sinks[i], true); });
 
   v.group("solver", info("the simulator"), [&] {
     std::vector<std::string> methods;

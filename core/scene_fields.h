@@ -26,6 +26,9 @@ class SceneVisitor {
   virtual void text(const char* key, std::string& value, const FieldInfo& info) = 0;
   virtual void choice(const char* key, std::string& value, const std::vector<std::string>& options,
                       const FieldInfo& info) = 0;
+  // A list of distinct names, each one of `options` (domain.open's faces).
+  virtual void choices(const char* key, std::vector<std::string>& values, const std::vector<std::string>& options,
+                       const FieldInfo& info) = 0;
   virtual void integer(const char* key, int& value, const FieldInfo& info) = 0;
   virtual void real(const char* key, double& value, const FieldInfo& info) = 0;
   // A vector of `dimensions` components (the scene's, or 3 when `always3`).

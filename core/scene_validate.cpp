@@ -91,6 +91,79 @@ void validateSolids(Scene& s, const std::string& where) {
   }
 }
 
+// Fluid blocks: a box inside the tank, or a shape of the bodies' vocabulary (geometry/ checks its file and that
+// it lies in the tank).
+void validateFluids(Scene& s, const std::string& where) {
+  for (size_t i = 0; i < s.fluids.size(); ++i) {
+    FluidBlock& fluid = s.fluids[i];
+    const std::string key = "fluids[" + std::to_string(i) + "]";
+    const Box& b = fluid.box;
+    if (fluid.shaped()) {
+      const std::string& shape = fluid.solid.shape;
+      if (shape != "box" && shape != "sphere" && shape != "capsule" && shape != "cylinder" && shape != "mesh")
+        throw InputError(where, key + ".shape", "'" + shape + "' is not one of: box, sphere, capsule, cylinder, mesh");
+      if (shape == "mesh" && s.dimensions == 2) throw InputError(where, key + ".shape", "a mesh fluid needs 3 dimensions");
+      if (b.min != b.max) throw InputError(where, key + ".box", "give the fluid a box or a shape, not both");
+      std::set<std::string> names;
+      validateSolid(fluid.solid, key, "fluid" + std::to_string(i), s.dimensions, names, where);
+      continue;
+    }
+    for (int k = 0; k < s.dimensions; ++k) {
+      if (!(b.min[k] < b.max[k]))
+        throw InputError(where, key + ".box", "min must be below max on every axis (or give a shape)");
+      if (b.min[k] < s.domain.min[k] || b.max[k] > s.domain.max[k])
+        throw InputError(where, key + ".box", "lies outside the domain");
+    }
+  }
+}
+
+// Emitters, sinks and open faces: what can be checked without the geometry (sim/sources.cpp checks that an
+// emitter is clear of the colliders and that the sinks leave some of the fluid).
+void validateSources(Scene& s, const std::string& where) {
+  const int d = s.dimensions;
+  for (const std::string& face : s.open)
+    if (d == 2 && face.back() == 'z')
+      throw InputError(where, "domain.open", "'" + face + "' does not exist in 2D (faces -x, +x, -y, +y)");
+  std::set<std::string> names;
+  for (size_t i = 0; i < s.emitters.size(); ++i) {
+    EmitterSettings& e = s.emitters[i];
+    const std::string key = "emitters[" + std::to_string(i) + "]";
+    if (e.name.empty()) e.name = "emitter" + std::to_string(i);
+    if (!isPlainName(e.name))
+      throw InputError(where, key + ".name", "must be letters, digits, '-', '_' or '.', not starting with '.'");
+    if (!names.insert(e.name).second) throw InputError(where, key + ".name", "'" + e.name + "' is used twice");
+    if (!(e.direction.head(d).norm() > 0)) throw InputError(where, key + ".direction", "must not be the zero vector");
+    if (e.shape == "rectangle") {
+      if (d == 2) throw InputError(where, key + ".shape", "a rectangle needs 3 dimensions; in 2D a disc is a segment");
+      if (e.size.size() != 2 || !(e.size[0] > 0) || !(e.size[1] > 0))
+        throw InputError(where, key + ".size", "a rectangle needs its [width, height], both > 0");
+    } else if (!e.size.empty()) {
+      throw InputError(where, key + ".size", "only a rectangle has a size; a disc has a radius");
+    }
+    if (e.stop != 0 && !(e.stop > e.start)) throw InputError(where, key + ".stop", "must be after start (or 0: never)");
+    for (int k = 0; k < d; ++k)
+      if (e.position[k] < s.domain.min[k] || e.position[k] > s.domain.max[k])
+        throw InputError(where, key + ".position", "lies outside the tank");
+    for (size_t k = 0; k < e.motion.size(); ++k) {
+      const std::string frameKey = key + ".motion[" + std::to_string(k) + "]";
+      if (k > 0 && e.motion[k].time < e.motion[k - 1].time)
+        throw InputError(where, frameKey + ".time", "keyframes must be in time order");
+      for (int a = 0; a < d; ++a)
+        if (e.motion[k].position[a] < s.domain.min[a] || e.motion[k].position[a] > s.domain.max[a])
+          throw InputError(where, frameKey + ".position", "lies outside the tank");
+    }
+  }
+  names.clear();
+  for (size_t i = 0; i < s.sinks.size(); ++i) {
+    ColliderSettings& c = s.sinks[i];
+    const std::string key = "sinks[" + std::to_string(i) + "]";
+    validateSolid(c, key, "sink" + std::to_string(i), d, names, where);
+    if (c.shape == "plane" && !(c.normal.norm() > 0))
+      throw InputError(where, key + ".normal", "must not be the zero vector");
+    if (c.thickness == 0) c.thickness = s.particle_spacing;
+  }
+}
+
 }  // namespace
 
 void validateScene(Scene& s, const std::string& where) {
@@ -101,20 +174,15 @@ void validateScene(Scene& s, const std::string& where) {
   for (int k = 0; k < d; ++k)
     if (!(s.domain.min[k] < s.domain.max[k]))
       throw InputError(where, "domain", "min must be below max on every axis");
-  for (size_t i = 0; i < s.fluids.size(); ++i) {
-    const std::string key = "fluids[" + std::to_string(i) + "].box";
-    const Box& b = s.fluids[i].box;
-    for (int k = 0; k < d; ++k) {
-      if (!(b.min[k] < b.max[k])) throw InputError(where, key, "min must be below max on every axis");
-      if (b.min[k] < s.domain.min[k] || b.max[k] > s.domain.max[k])
-        throw InputError(where, key, "lies outside the domain");
-    }
-  }
+  validateFluids(s, where);
   const double spacing = s.particle_spacing;
-  const size_t count = s.particleCount();
-  if (count == 0)
+  const bool shaped = std::any_of(s.fluids.begin(), s.fluids.end(), [](const FluidBlock& f) { return f.shaped(); });
+  if (s.fluids.empty() && s.emitters.empty())
+    throw InputError(where, "fluids", "the scene has no fluid: give a fluid block or an emitter");
+  if (!s.fluids.empty() && !shaped && s.particleCount() == 0)
     throw InputError(where, "fluids",
                      "the fluid boxes hold no particles at particle_spacing " + formatNumber(spacing));
+  validateSources(s, where);
 
   SolverSettings& solver = s.solver;
   if (solver.kernel_radius == 0) solver.kernel_radius = 2 * spacing;
@@ -159,6 +227,7 @@ Eigen::Array3i latticeCounts(const Scene& scene, const Box& box) {
 size_t Scene::particleCount() const {
   size_t total = 0;
   for (const FluidBlock& fluid : fluids) {
+    if (fluid.shaped()) continue;
     const Eigen::Array3i n = latticeCounts(*this, fluid.box);
     total += size_t(n[0]) * size_t(n[1]) * size_t(n[2]);
   }

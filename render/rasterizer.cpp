@@ -318,15 +318,9 @@ struct Rasterizer::Impl {
 
   void drawTankEdges() {
     std::vector<Vec3> positions;
-    for (int axis = 0; axis < 3; ++axis) {
-      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-      for (int corner = 0; corner < 4; ++corner) {
-        Vec3 p0 = lo, p1 = hi;
-        p0[a] = p1[a] = (corner & 1) ? hi[a] : lo[a];
-        p0[b] = p1[b] = (corner & 2) ? hi[b] : lo[b];
-        positions.push_back(p0);
-        positions.push_back(p1);
-      }
+    for (const auto& [p0, p1] : surge::tankEdges(scene)) {
+      positions.push_back(p0);
+      positions.push_back(p1);
     }
     const std::vector<Rgba> colours(positions.size(), Rgba{30, 30, 34, 255});
     glLineWidth(float(std::max(2, height / 300)));
@@ -348,13 +342,17 @@ struct Rasterizer::Impl {
 
   void drawOutline2d() {
     const float z = hi.z() + 10 * size;  // in front of the fluid
-    const std::vector<Vec3> positions = {
-        {lo.x(), hi.y(), z}, {lo.x(), lo.y(), z}, {hi.x(), lo.y(), z}, {hi.x(), hi.y(), z}};
-    const std::vector<Rgba> colours(4, Rgba{40, 40, 44, 255});
+    std::vector<Vec3> positions;
+    for (auto [p0, p1] : surge::tankEdges(scene)) {
+      p0.z() = p1.z() = z;
+      positions.push_back(p0);
+      positions.push_back(p1);
+    }
+    const std::vector<Rgba> colours(positions.size(), Rgba{40, 40, 44, 255});
     glLineWidth(float(std::max(2, height / 250)));
     glVertexPointer(3, GL_FLOAT, 0, positions.data());
     glColorPointer(4, GL_UNSIGNED_BYTE, 0, colours.data());
-    glDrawArrays(GL_LINE_STRIP, 0, 4);
+    glDrawArrays(GL_LINES, 0, GLsizei(positions.size()));
   }
 
   static void drawArrays(const std::vector<Vec3>& positions, const std::vector<Rgba>& colours) {

@@ -21,6 +21,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
+#include <vector>
 
 #include "core/scene.h"
 #include "render/random.h"
@@ -87,5 +89,9 @@ Eigen::Vector3f traceRadiance(const RayScene& world, const Shading& shading, con
 
 // Linear light to display: exposure, then the ACES filmic curve fitted by Narkowicz (2015), in [0, 1].
 float toneMap(float linear, float exposure);
+
+// The tank's edges to draw, as segments: in 3D its twelve edges less those of an open face (domain.open), in 2D
+// its floor and side walls (z = 0) less the open ones.
+std::vector<std::array<Eigen::Vector3f, 2>> tankEdges(const Scene& scene);
 
 }  // namespace surge

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "render/shading.h"
 
 namespace surge {
 
@@ -185,6 +186,8 @@ RayScene::RayScene(const RayDevice& device, const TriangleMesh& water, const Sce
     for (int axis : {0, 2}) {
       const int across = 2 - axis;  // the other horizontal axis
       for (float at : {outerLo[axis], outerHi[axis]}) {
+        const std::string face = std::string(at == outerHi[axis] ? "+" : "-") + char('x' + axis);
+        if (std::find(scene.open.begin(), scene.open.end(), face) != scene.open.end()) continue;  // no pane
         const auto base = static_cast<uint32_t>(glass.positions.size());
         for (int corner = 0; corner < 4; ++corner) {
           Eigen::Vector3f p;
@@ -202,16 +205,8 @@ RayScene::RayScene(const RayDevice& device, const TriangleMesh& water, const Sce
     // The tank's twelve edges as square bars of half-width r (corners overlap, which reads as a frame).
     const float r = 0.003f * size;
     Triangles tank;
-    for (int axis = 0; axis < 3; ++axis) {
-      const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-      for (int corner = 0; corner < 4; ++corner) {
-        Eigen::Vector3f p0 = lo, p1 = hi;
-        p0[a] = p1[a] = (corner & 1) ? hi[a] : lo[a];
-        p0[b] = p1[b] = (corner & 2) ? hi[b] : lo[b];
-        tank.addBox(p0.array() - r, p1.array() + r);
-      }
-    }
-    attachTriangles(dev.device, impl_->scene, kTankId, kSeen, tank.positions, tank.indices);
+    for (const auto& [p0, p1] : tankEdges(scene)) tank.addBox(p0.array() - r, p1.array() + r);
+    if (!tank.indices.empty()) attachTriangles(dev.device, impl_->scene, kTankId, kSeen, tank.positions, tank.indices);
   }
 
   if (!water.triangles.empty())

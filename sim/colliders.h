@@ -218,6 +218,12 @@ class Colliders {
   // kChunk; takeFrameWrenches returns each collider's mean force and torque (about its position) over the
   // frame's `duration` and starts the next frame.
   void resetSlots(size_t particles);
+  // For a new particle count between steps (emitters, sinks): the impulses recorded so far move to the frame's
+  // sums, so the frame's wrench keeps them.
+  void resizeSlots(size_t particles) {
+    addWrenches(takeSlotSums(), 1.0);
+    resetSlots(particles);
+  }
   void addImpulse(size_t particle, size_t c, const VecD& impulse, const VecD& at) {
     Wrench& w = slots_[(particle / kChunk) * placed_.size() + c];
     Eigen::Vector3d j = Eigen::Vector3d::Zero(), r = Eigen::Vector3d::Zero();

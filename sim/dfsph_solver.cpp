@@ -41,24 +41,9 @@ DfsphSolver<Dim>::DfsphSolver(const Scene& scene, std::shared_ptr<const Collider
 
 template <int Dim>
 void DfsphSolver<Dim>::resizeChannels(size_t n) {
-  densityWarm_.assign(n, 0.0f);
-  divergenceWarm_.assign(n, 0.0f);
+  sizeChannel(densityWarm_, n, 0.0f);
+  sizeChannel(divergenceWarm_, n, 0.0f);
   prepared_ = false;
-}
-
-// The two solvers' lambda totals, particle by particle.
-template <int Dim>
-std::vector<float> DfsphSolver<Dim>::carriedState() const {
-  std::vector<float> state(densityWarm_);
-  state.insert(state.end(), divergenceWarm_.begin(), divergenceWarm_.end());
-  return state;
-}
-
-template <int Dim>
-void DfsphSolver<Dim>::restoreCarriedState(const std::vector<float>& state) {
-  if (state.size() != 2 * size()) throw std::invalid_argument("DFSPH: carried state of the wrong size");
-  densityWarm_.assign(state.begin(), state.begin() + std::ptrdiff_t(size()));
-  divergenceWarm_.assign(state.begin() + std::ptrdiff_t(size()), state.end());
 }
 
 template <int Dim>

@@ -49,9 +49,6 @@ class DfsphSolver final : public ParticleSolver<Dim> {
 
   explicit DfsphSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes = nullptr);
 
-  std::vector<float> carriedState() const override;
-  void restoreCarriedState(const std::vector<float>& state) override;
-
   int fixedSubsteps() const override { return 0; }
   float stableTimeStep() override;
   void beginFrame(double time) override;
@@ -71,6 +68,11 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   using Core::restDensity_, Core::vectorScratch_, Core::floatScratch_;
 
   void resizeChannels(size_t n) override;
+  // The two solvers' lambda totals, particle by particle.
+  void forEachCarriedChannel(const std::function<void(std::vector<float>&)>& visit) override {
+    visit(densityWarm_);
+    visit(divergenceWarm_);
+  }
   // Sorts the particles into the grid (reordering every channel) and computes, at the current positions, the
   // neighbour lists, each pair's g_ij, each particle's wall gradient G_i, density ratio and S_i.
   void prepareStep();

@@ -21,6 +21,27 @@
 
 namespace surge {
 
+// Particles entering and leaving between two steps (sim/sources.h): the indices (in the solver's current order)
+// to remove, in increasing order; particles given a new velocity (an emitter's nozzle); and new particles.
+template <int Dim>
+struct ParticleEdit {
+  std::vector<uint32_t> remove;
+  std::vector<uint32_t> steer;
+  std::vector<Vec<Dim>> steerVelocity;
+  std::vector<Vec<Dim>> addPosition, addVelocity;
+  std::vector<uint32_t> addId;
+
+  bool empty() const { return remove.empty() && steer.empty() && addPosition.empty(); }
+  void clear() {
+    remove.clear();
+    steer.clear();
+    steerVelocity.clear();
+    addPosition.clear();
+    addVelocity.clear();
+    addId.clear();
+  }
+};
+
 template <int Dim>
 class FluidSolver {
  public:
@@ -43,10 +64,14 @@ class FluidSolver {
   // resumed from a frame file continues exactly as an uninterrupted one.
   virtual void beginFrame(double time) = 0;
   // What a method carries from frame to frame beyond positions and velocities (DFSPH's warm starts), in the
-  // order of getParticles: the frame loop writes it beside each particle frame and gives it back on resume.
-  // Empty for a method that carries nothing.
+  // order of getParticles, as channels of one float a particle one after another: the frame loop writes it
+  // beside each particle frame and gives it back on resume. Empty for a method that carries nothing.
   virtual std::vector<float> carriedState() const { return {}; }
   virtual void restoreCarriedState(const std::vector<float>&) {}
+  // Between two steps: steers, removes and adds particles (ParticleEdit). Surviving particles keep their order
+  // and carried state, new ones come last with none; no allocation unless the count outgrows the capacity,
+  // which then grows by half.
+  virtual void editParticles(const ParticleEdit<Dim>& edit) = 0;
   // One step of dt from `time`. Returns the index of the first particle that is not finite, left the tank or
   // ran away (firstParticleOutside), or -1 if all are well.
   virtual long step(float dt, double time) = 0;

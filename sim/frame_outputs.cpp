@@ -86,6 +86,8 @@ const StatsColumn kStatsColumns[] = {
     {"divergence_iterations", [](const FrameRecord& r) { return printed("%.2f", r.divergenceIterations); }},
     {"front_x", [](const FrameRecord& r) { return printed("%.6g", r.dam.frontX); }},
     {"back_height", [](const FrameRecord& r) { return printed("%.6g", r.dam.backHeight); }},
+    {"emitted", [](const FrameRecord& r) { return std::to_string(r.emitted); }},
+    {"removed", [](const FrameRecord& r) { return std::to_string(r.removed); }},
 };
 
 class StatsOutput final : public FrameOutput {

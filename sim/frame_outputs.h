@@ -35,6 +35,7 @@ struct FrameRecord {
   double divergenceIterations = NAN;  // a step, on average; NaN for a method without a divergence solver
   double smallestStep = 0, wallSeconds = 0;
   double pressureMax = NAN;      // NaN for a method without pressures
+  size_t emitted = 0, removed = 0;  // particles the emitters added, and the sinks and open faces removed
   PhaseTimes phases;
   std::vector<Wrench> colliderWrenches, bodyWrenches;  // the frame's mean; empty at frame 0
   std::vector<float> carriedState;                     // FluidSolver::carriedState

@@ -1,5 +1,7 @@
 #include "sim/particle_solver.h"
 
+#include <stdexcept>
+
 #include "sim/solver_defaults.h"
 
 namespace surge {
@@ -20,7 +22,7 @@ ParticleSolver<Dim>::ParticleSolver(const Scene& scene, std::shared_ptr<const Co
       mass_(static_cast<float>(scene.solver.rest_density / lattice.weightSum)),
       gravity_(toVec<Dim>(scene.gravity)),
       attractor_(scene.attractor),
-      grid_(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max),
+      grid_(lattice.walls.domainMin(), lattice.walls.domainMax(),
             NeighborGrid<Dim>::cellSizeFor(static_cast<float>(scene.solver.kernel_radius))),
       walls_(std::move(lattice.walls)),
       sceneSpeedLimit_(static_cast<float>(runawaySpeed(scene))) {
@@ -55,6 +57,67 @@ void ParticleSolver<Dim>::getParticles(ParticleFrame& frame) const {
     frame.velocity[i].head<Dim>() = v_[i];
   }
   frame.id = id_;
+}
+
+template <int Dim>
+void ParticleSolver<Dim>::editParticles(const ParticleEdit<Dim>& edit) {
+  for (size_t k = 0; k < edit.steer.size(); ++k) v_[edit.steer[k]] = edit.steerVelocity[k];
+  if (edit.remove.empty() && edit.addPosition.empty()) return;
+  const size_t before = x_.size();
+  // The survivors move down over the removed, in order, with their carried channels.
+  auto compact = [&](auto& channel) {
+    size_t kept = 0, r = 0;
+    for (size_t i = 0; i < before; ++i) {
+      if (r < edit.remove.size() && edit.remove[r] == i) {
+        ++r;
+        continue;
+      }
+      channel[kept++] = channel[i];
+    }
+    channel.resize(kept);
+  };
+  if (!edit.remove.empty()) {
+    compact(x_);
+    compact(v_);
+    compact(id_);
+  }
+  x_.insert(x_.end(), edit.addPosition.begin(), edit.addPosition.end());
+  v_.insert(v_.end(), edit.addVelocity.begin(), edit.addVelocity.end());
+  id_.insert(id_.end(), edit.addId.begin(), edit.addId.end());
+  const size_t n = x_.size();
+  // The carried channels step aside while the method sizes its others, then come back, new particles at 0.
+  size_t channels = 0;
+  forEachCarriedChannel([&](std::vector<float>& channel) {
+    if (!edit.remove.empty()) compact(channel);
+    channel.resize(n, 0.0f);
+    if (carriedHold_.size() <= channels) carriedHold_.emplace_back();
+    carriedHold_[channels++].swap(channel);
+  });
+  resizeChannels(n);
+  channels = 0;
+  forEachCarriedChannel([&](std::vector<float>& channel) { carriedHold_[channels++].swap(channel); });
+  colliders_.resizeSlots(n);
+}
+
+// The carried channels one after another.
+template <int Dim>
+std::vector<float> ParticleSolver<Dim>::carriedState() const {
+  std::vector<float> state;
+  const_cast<ParticleSolver*>(this)->forEachCarriedChannel(
+      [&](std::vector<float>& channel) { state.insert(state.end(), channel.begin(), channel.end()); });
+  return state;
+}
+
+template <int Dim>
+void ParticleSolver<Dim>::restoreCarriedState(const std::vector<float>& state) {
+  size_t channels = 0;
+  forEachCarriedChannel([&](std::vector<float>&) { ++channels; });
+  if (state.size() != channels * size()) throw std::invalid_argument("carried state of the wrong size");
+  size_t at = 0;
+  forEachCarriedChannel([&](std::vector<float>& channel) {
+    channel.assign(state.begin() + std::ptrdiff_t(at), state.begin() + std::ptrdiff_t(at + size()));
+    at += size();
+  });
 }
 
 template <int Dim>

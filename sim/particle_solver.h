@@ -9,6 +9,8 @@
 // neighbour lists directly (no accessor per particle), and FluidSolver's bookkeeping is written once.
 #pragma once
 
+#include <algorithm>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -29,6 +31,28 @@ Vec<Dim> toVec(const Eigen::Vector3d& v) {
   return v.head<Dim>().template cast<float>();
 }
 
+// Sizes a channel to n values, growing its capacity by half at least, so that a count that keeps growing (an
+// emitter's) reallocates rarely.
+template <typename T>
+void sizeChannel(std::vector<T>& channel, size_t n, const T& value) {
+  if (n > channel.capacity()) channel.reserve(std::max(n, channel.capacity() + channel.capacity() / 2));
+  channel.assign(n, value);
+}
+
+// The box the tank's walls stand on: the domain, with each open face (domain.open) moved out by two kernel
+// radii, where it reaches no particle inside the domain; a particle that crosses an open face is removed at the
+// end of its step (sim/sources.h).
+template <int Dim>
+void tankWallBox(const Scene& scene, Vec<Dim>& lower, Vec<Dim>& upper) {
+  lower = toVec<Dim>(scene.domain.min);
+  upper = toVec<Dim>(scene.domain.max);
+  const float margin = 2 * static_cast<float>(scene.solver.kernel_radius);
+  for (const std::string& face : scene.open) {
+    const int axis = face[1] - 'x';
+    if (axis < Dim) (face[0] == '-' ? lower[axis] -= margin : upper[axis] += margin);
+  }
+}
+
 // The scene's SPH kernel (WCSPH, DFSPH).
 template <int Dim>
 SphKernel<Dim> sphKernel(const Scene& scene) {
@@ -46,10 +70,17 @@ struct RestLattice {
 
   template <typename Weight, typename Gradient>
   RestLattice(const Scene& scene, float radius, Weight weight, Gradient gradient)
-      : walls(toVec<Dim>(scene.domain.min), toVec<Dim>(scene.domain.max), static_cast<float>(scene.particle_spacing),
-              radius, weight, gradient) {
+      : walls(wallBox(scene, 0), wallBox(scene, 1), static_cast<float>(scene.particle_spacing), radius, weight,
+              gradient) {
     latticeSums<Dim>(static_cast<float>(scene.particle_spacing), radius, weight, gradient, &weightSum,
                      &gradientSquaredSum);
+  }
+
+ private:
+  static Vec<Dim> wallBox(const Scene& scene, int corner) {
+    Vec<Dim> lower, upper;
+    tankWallBox<Dim>(scene, lower, upper);
+    return corner == 0 ? lower : upper;
   }
 };
 
@@ -68,6 +99,9 @@ class ParticleSolver : public FluidSolver<Dim> {
 
   void setParticles(const ParticleFrame& frame) final;
   void getParticles(ParticleFrame& frame) const final;
+  void editParticles(const ParticleEdit<Dim>& edit) final;
+  std::vector<float> carriedState() const final;
+  void restoreCarriedState(const std::vector<float>& state) final;
   size_t size() const final { return x_.size(); }
   const std::vector<VecD>& positions() const final { return x_; }
   const std::vector<VecD>& velocities() const final { return v_; }
@@ -82,8 +116,11 @@ class ParticleSolver : public FluidSolver<Dim> {
   // particle mass. `shapes`: the scene's collider shapes, null builds them.
   ParticleSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, RestLattice<Dim> lattice);
 
-  // The method's own channels, sized for the n particles setParticles was given.
+  // The method's own channels, sized for the n particles setParticles or editParticles left (sizeChannel).
   virtual void resizeChannels(size_t n) = 0;
+  // Visits the channels the method carries from step to step and frame to frame (FluidSolver::carriedState),
+  // one float a particle each, in a fixed order; none by default. editParticles keeps them with their particles.
+  virtual void forEachCarriedChannel(const std::function<void(std::vector<float>&)>& visit) { (void)visit; }
 
   // Sorts the particles into the grid at `key` (x_, or a method's predicted positions) and reorders x_, v_, id_,
   // `key` and every channel given by cell, so that neighbours are close in memory; an empty channel is skipped.
@@ -145,6 +182,7 @@ class ParticleSolver : public FluidSolver<Dim> {
   std::vector<float>& scratchFor(std::vector<float>&) { return floatScratch_; }
   std::vector<uint32_t>& scratchFor(std::vector<uint32_t>&) { return idScratch_; }
 
+  std::vector<std::vector<float>> carriedHold_;  // editParticles: the carried channels while the rest resize
   float sceneSpeedLimit_;  // runawaySpeed(scene)
   float speedLimit_ = 0;   // and ten times the fastest particle given (runawaySpeedFor): faster is a blow-up
 };

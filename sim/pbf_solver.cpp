@@ -73,8 +73,8 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
 template <int Dim>
 void PbfSolver<Dim>::resizeChannels(size_t n) {
   p_.resize(n);
-  lambda_.assign(n, 0.0f);
-  if (warmStart_ > 0) lambdaTotal_.assign(n, 0.0f);
+  sizeChannel(lambda_, n, 0.0f);
+  if (warmStart_ > 0) sizeChannel(lambdaTotal_, n, 0.0f);
   foundHolds_ = false;
   if (!colliders_.empty()) {
     found_.resize(n);
@@ -170,12 +170,6 @@ void PbfSolver<Dim>::applyWarmStart() {
   });
   foundHolds_ = !colliders_.empty();
   applyPositionCorrections<true>();
-}
-
-template <int Dim>
-void PbfSolver<Dim>::restoreCarriedState(const std::vector<float>& state) {
-  if (state.size() != lambdaTotal_.size()) throw std::invalid_argument("PBF: carried state of the wrong size");
-  lambdaTotal_ = state;
 }
 
 // Eq. 2: rho_i = sum_j m W_poly6(p_i - p_j, h). Eq. 1: C_i = rho_i / rho_0 - 1, used one-sided (only

@@ -51,8 +51,6 @@ class PbfSolver final : public ParticleSolver<Dim> {
   long step(float dt, double time = 0) override;
 
   FluidMeasures measure() override;
-  std::vector<float> carriedState() const override { return lambdaTotal_; }
-  void restoreCarriedState(const std::vector<float>& state) override;
   int lastIterations() const override { return lastIterations_; }
   // Bytes held by every particle channel, the grid, the neighbour lists and the pair factors (capacities).
   size_t memoryBytes() const;
@@ -65,6 +63,9 @@ class PbfSolver final : public ParticleSolver<Dim> {
   using Core::vectorScratch_, Core::restDensity_;
 
   void resizeChannels(size_t n) override;
+  void forEachCarriedChannel(const std::function<void(std::vector<float>&)>& visit) override {
+    if (warmStart_ > 0) visit(lambdaTotal_);
+  }
   void predictPositions(float dt, double time);
   void findNeighbors();
   void solveDensityConstraints();

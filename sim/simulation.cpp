@@ -13,10 +13,13 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/scene_fields.h"
+#include "geometry/collider_shape.h"
 #include "geometry/pose.h"
 #include "sim/fluid_solver.h"
 #include "sim/frame_outputs.h"
 #include "sim/rigid_bodies.h"
+#include "sim/sources.h"
 #include "sim/solver_defaults.h"
 
 namespace surge {
@@ -42,7 +45,7 @@ void removeStaleFiles(const fs::path& folder, bool framesToo) {
 
 // The x wall the fluid started against: +1 for domain.min.x, -1 for domain.max.x.
 int startWallSide(const Scene& scene) {
-  if (scene.fluids.empty()) return 1;
+  if (scene.fluids.empty() || scene.fluids.front().shaped()) return 1;
   const Box& box = scene.fluids.front().box;
   const double tolerance = 0.5 * scene.particle_spacing;
   if (box.min.x() <= scene.domain.min.x() + tolerance) return 1;
@@ -72,21 +75,23 @@ float walkWhileContiguous(const std::vector<float>& sorted, size_t start, float 
 // otherwise each step is the largest stable one (stableTimeStep) shortened so the steps left end exactly on the
 // frame: dt = remaining / ceil(remaining / stable).
 // The particles run() starts from: the newest frame of a resumed run (with the method's carried state and the
-// bodies' states there), or the scene's fluid less what lies inside colliders and bodies.
+// bodies' states there), or the scene's fluid less what lies inside colliders and bodies. Returns the initial
+// lattice's count, where the emitters' ids begin.
 template <int Dim>
-void startParticles(const Scene& scene, const fs::path& dir, bool resume, FluidSolver<Dim>& solver,
-                    RigidBodies* bodies, SimulationSummary& summary) {
+uint32_t startParticles(const Scene& scene, const fs::path& dir, bool resume, FluidSolver<Dim>& solver,
+                        RigidBodies* bodies, SimulationSummary& summary) {
   const std::vector<int> existing = resume ? listFrames(dir, "particles", "ply") : std::vector<int>{};
+  ParticleFrame initial = initialParticles(scene);
+  const auto firstEmittedId = static_cast<uint32_t>(initial.size());
   if (existing.empty()) {
-    ParticleFrame initial = initialParticles(scene);
     if (!scene.colliders.empty() || bodies) {
       summary.removedParticles = removeParticlesInside(solver.colliders(), initial);
-      if (initial.size() == 0)
+      if (initial.size() == 0 && scene.emitters.empty())
         throw InputError(scene.source, scene.colliders.empty() ? "bodies" : "colliders",
                          "every fluid particle lies inside a collider or a body");
     }
     solver.setParticles(initial);
-    return;
+    return firstEmittedId;
   }
   summary.firstFrame = std::min(existing.back(), scene.output.frames);
   const fs::path path = framePath(dir, "particles", summary.firstFrame, "ply");
@@ -97,6 +102,7 @@ void startParticles(const Scene& scene, const fs::path& dir, bool resume, FluidS
   if (carried > 0 && summary.firstFrame < scene.output.frames)
     solver.restoreCarriedState(readCarriedState(dir, summary.firstFrame, carried));
   if (bodies) bodies->setStates(readBodyStates(framePath(dir, "bodies", summary.firstFrame, "txt"), scene));
+  return firstEmittedId;
 }
 
 // The frame loop, for any solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
@@ -120,8 +126,14 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     fs::create_directories(dir / "bodies");
   }
   SimulationSummary summary;
-  startParticles<Dim>(scene, dir, resume, solver, bodies.get(), summary);
+  const uint32_t firstEmittedId = startParticles<Dim>(scene, dir, resume, solver, bodies.get(), summary);
   const bool fresh = !resume || listFrames(dir, "particles", "ply").empty();
+  const double frameDuration = 1.0 / scene.output.fps;
+  std::unique_ptr<FluidSources<Dim>> sources;
+  if (scene.hasSources()) {
+    sources = std::make_unique<FluidSources<Dim>>(scene, firstEmittedId, summary.firstFrame * frameDuration);
+    if (fresh) sources->checkStart(solver.positions(), solver.colliders());
+  }
   const std::vector<std::unique_ptr<FrameOutput>> outputs =
       makeFrameOutputs(scene, shapes, bodies.get(), dir, resume, !fresh, summary.firstFrame);
   ParticleFrame frame;
@@ -141,13 +153,13 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     writeFrame();
   }
 
-  const double frameDuration = 1.0 / scene.output.fps;
   constexpr int kMostSteps = 1000000;
   progress.start("simulate", static_cast<size_t>(scene.output.frames - summary.firstFrame));
   for (int f = summary.firstFrame + 1; f <= scene.output.frames; ++f) {
     Progress::checkInterrupt();
     const auto frameStart = std::chrono::steady_clock::now();
     solver.phaseTimes() = PhaseTimes{};
+    if (sources) sources->emitted = sources->removed = 0;
     double time = (f - 1) * frameDuration;
     solver.beginFrame(time);
     if (bodies) {
@@ -181,6 +193,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
         solver.getParticles(frame);
         diverged(scene, f, steps, bad, frame);
       }
+      if (sources) sources->apply(solver, time);
       if (++steps >= kMostSteps)
         throw RunError("simulation stalled at frame " + std::to_string(f) + ": a million steps of " +
                        std::to_string(dt) + " s did not finish the frame (the stable step collapsed)");
@@ -196,6 +209,10 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     record.divergenceIterations = divergenceIterations < 0 ? NAN : double(divergenceIterations) / steps;
     record.smallestStep = smallestStep;
     record.pressureMax = solver.maxPressure();
+    if (sources) {
+      record.emitted = sources->emitted;
+      record.removed = sources->removed;
+    }
     record.phases = solver.phaseTimes();
     record.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart).count();
     if (!scene.colliders.empty() || bodies) {
@@ -212,6 +229,40 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
   summary.particles = solver.size();
   summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - runStart).count();
   return summary;
+}
+
+// A fluid given as a shape: the sites of the tank's lattice (domain.min + spacing (i + 1/2)) inside it.
+void addShapedFluid(const Scene& scene, size_t index, ParticleFrame& frame) {
+  const FluidBlock& fluid = scene.fluids[index];
+  const std::string key = "fluids[" + std::to_string(index) + "]";
+  const ColliderShape shape = buildSolidShape(scene, fluid.solid, key, true);
+  const Pose pose = colliderPose(fluid.solid, 0.0);
+  Eigen::AlignedBox3d world;
+  for (int corner = 0; corner < 8; ++corner)
+    world.extend(pose.toWorld(shape.bounds.corner(Eigen::AlignedBox3f::CornerType(corner)).cast<double>()));
+  const double s = scene.particle_spacing;
+  Eigen::Array3i lo(0, 0, 0), hi(0, 0, 0);
+  for (int k = 0; k < scene.dimensions; ++k) {
+    const double min = std::max(world.min()[k], scene.domain.min[k]), max = std::min(world.max()[k], scene.domain.max[k]);
+    lo[k] = static_cast<int>(std::floor((min - scene.domain.min[k]) / s));
+    hi[k] = static_cast<int>(std::ceil((max - scene.domain.min[k]) / s));
+  }
+  const size_t before = frame.size();
+  for (int k = lo[2]; k <= hi[2]; ++k)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int i = lo[0]; i <= hi[0]; ++i) {
+        Eigen::Vector3d p = scene.domain.min + s * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5);
+        if (scene.dimensions == 2) p.z() = 0;
+        if (((p - scene.domain.min).head(scene.dimensions).array() < 0).any() ||
+            ((scene.domain.max - p).head(scene.dimensions).array() < 0).any())
+          continue;
+        if (!(shape.distance(pose.toLocal(p).cast<float>()) < 0)) continue;
+        frame.position.push_back(p.cast<float>());
+        frame.velocity.push_back(fluid.velocity.cast<float>());
+        frame.id.push_back(static_cast<uint32_t>(frame.id.size()));
+      }
+  if (frame.size() == before)
+    throw InputError(scene.source, key, "the shape holds no lattice site at particle_spacing " + formatNumber(s));
 }
 
 }  // namespace
@@ -238,7 +289,7 @@ DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame)
 }
 
 bool isDamBreak(const Scene& scene) {
-  if (scene.fluids.size() != 1) return false;
+  if (scene.fluids.size() != 1 || scene.fluids.front().shaped()) return false;
   const Box& box = scene.fluids.front().box;
   const double tolerance = 0.5 * scene.particle_spacing;
   const bool onFloor = box.min.y() <= scene.domain.min.y() + tolerance;
@@ -255,7 +306,12 @@ ParticleFrame initialParticles(const Scene& scene) {
   frame.velocity.reserve(total);
   frame.id.reserve(total);
   const double spacing = scene.particle_spacing;
-  for (const FluidBlock& fluid : scene.fluids) {
+  for (size_t f = 0; f < scene.fluids.size(); ++f) {
+    const FluidBlock& fluid = scene.fluids[f];
+    if (fluid.shaped()) {
+      addShapedFluid(scene, f, frame);
+      continue;
+    }
     const Eigen::Array3i n = latticeCounts(scene, fluid.box);
     for (int k = 0; k < n[2]; ++k)
       for (int j = 0; j < n[1]; ++j)

@@ -5,9 +5,39 @@
 
 #include "core/errors.h"
 #include "core/process.h"
+#include "geometry/mass_properties.h"
 #include "sim/fluid_solver.h"
+#include "sim/sources.h"
 
 namespace surge {
+namespace {
+
+// The fastest an emitter pushes fluid out (its speed, or a keyframe's).
+double fastestEmitter(const Scene& scene) {
+  double speed = 0;
+  for (const EmitterSettings& e : scene.emitters) {
+    speed = std::max(speed, e.speed);
+    for (const EmitterKeyframe& k : e.motion) speed = std::max(speed, k.speed);
+  }
+  return speed;
+}
+
+}  // namespace
+
+double initialFluidVolume(const Scene& scene) {
+  const int d = scene.dimensions;
+  double volume = 0;
+  for (size_t i = 0; i < scene.fluids.size(); ++i) {
+    const FluidBlock& fluid = scene.fluids[i];
+    if (!fluid.shaped()) {
+      volume += (fluid.box.max - fluid.box.min).head(d).prod();
+      continue;
+    }
+    const ColliderShape shape = buildSolidShape(scene, fluid.solid, "fluids[" + std::to_string(i) + "]", true);
+    volume += massProperties(shape, fluid.solid.scale, d, 1.0).volume;
+  }
+  return volume;
+}
 
 int stableSubsteps(const Scene& scene) {
   const int d = scene.dimensions;
@@ -18,10 +48,14 @@ int stableSubsteps(const Scene& scene) {
   // section across the axis gravity is mostly along.
   int down = 0;
   gravity.cwiseAbs().maxCoeff(&down);
-  double floor = 1, volume = 0;
+  double floor = 1;
   for (int k = 0; k < d; ++k)
     if (k != down) floor *= scene.domain.max[k] - scene.domain.min[k];
-  for (const FluidBlock& fluid : scene.fluids) volume += (fluid.box.max - fluid.box.min).head(d).prod();
+  // What the emitters bring stays, unless the tank lets fluid out.
+  double volume = initialFluidVolume(scene);
+  if (scene.sinks.empty() && scene.open.empty())
+    volume += double(mostEmittedParticles(scene, scene.output.frames / scene.output.fps)) *
+              std::pow(scene.particle_spacing, d);
   const double depth = std::min(volume / floor, scene.domain.max[down] - scene.domain.min[down]);
   if (!(depth > 0)) return 1;
   const double longest = 0.9 * scene.particle_spacing / std::sqrt(g * depth);
@@ -37,6 +71,7 @@ void resolveSolverDefaults(Scene& scene) {
     // density then varies by about 1% (Monaghan 1994).
     double speed = std::sqrt(2 * scene.gravity.norm() * (scene.domain.max - scene.domain.min)[1]);
     for (const FluidBlock& fluid : scene.fluids) speed = std::max(speed, fluid.velocity.norm());
+    speed = std::max(speed, fastestEmitter(scene));
     solver.speed_of_sound = 10 * std::max(speed, 1.0);
   }
   if (solver.gas_constant == 0) solver.gas_constant = solver.speed_of_sound * solver.speed_of_sound;
@@ -49,6 +84,7 @@ double runawaySpeed(const Scene& scene) {
   const double diagonal = (scene.domain.max - scene.domain.min).head(d).norm();
   double fluid = 0, bodies = 0, colliders = 0, attractor = 0;
   for (const FluidBlock& block : scene.fluids) fluid = std::max(fluid, block.velocity.head(d).norm());
+  fluid = std::max(fluid, fastestEmitter(scene));
   for (const BodySettings& body : scene.bodies)
     bodies = std::max(bodies, body.velocity.head(d).norm() + body.angular_velocity.norm() * diagonal);
   for (const ColliderSettings& collider : scene.colliders)
@@ -79,8 +115,17 @@ size_t bytesPerParticleEstimate(int dimensions, const std::string& method) {
   return dimensions == 3 ? m.bytesPerParticle3d : m.bytesPerParticle2d;
 }
 
+size_t mostParticles(const Scene& scene) {
+  const bool shaped =
+      std::any_of(scene.fluids.begin(), scene.fluids.end(), [](const FluidBlock& f) { return f.shaped(); });
+  const size_t initial =
+      shaped ? size_t(initialFluidVolume(scene) / std::pow(scene.particle_spacing, scene.dimensions)) + 1
+             : scene.particleCount();
+  return initial + mostEmittedParticles(scene, scene.output.frames / scene.output.fps);
+}
+
 void checkSimulationMemory(const Scene& scene) {
-  const size_t count = scene.particleCount();
+  const size_t count = mostParticles(scene);
   const double bytes = double(count) * double(bytesPerParticleEstimate(scene.dimensions, scene.solver.method));
   const MemoryLimit memory = memoryLimit();
   if (count > (size_t(1) << 31) || bytes > 0.8 * memory.bytes)

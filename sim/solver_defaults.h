@@ -10,8 +10,16 @@
 
 namespace surge {
 
+// The volume of the scene's fluid at the start (m^3, m^2 in 2D): the boxes', and the shapes' (their mass
+// properties; a shape's file is read).
+double initialFluidVolume(const Scene& scene);
+// The most particles a run can hold: the initial fluid's (shapes estimated from their volume) and all the
+// emitters can make by the last frame.
+size_t mostParticles(const Scene& scene);
+
 // The fewest steps a frame with which a PBF column of fluid stays at rest: dt <= 0.9 spacing / sqrt(|g| H), H the
-// depth of the pool the fluid settles into (its volume over the tank's floor). Each step gravity moves every
+// depth of the pool the fluid settles into (its volume over the tank's floor, with what the emitters bring when
+// neither a sink nor an open face lets it out). Each step gravity moves every
 // particle by g dt^2, and a column of H / spacing layers sags by g dt^2 H / spacing before the iterations push it
 // back; near a spacing the layers pass through each other and the pool boils (docs/speed-accuracy.md).
 int stableSubsteps(const Scene& scene);
@@ -22,7 +30,7 @@ int stableSubsteps(const Scene& scene);
 void resolveSolverDefaults(Scene& scene);
 
 // The speed that marks a particle as run away (a diverged solver): ten times the fastest the scene can give a
-// particle, which is the sum of its initial speeds (fluid, bodies, with their spin over the tank's diagonal),
+// particle, which is the sum of its initial speeds (fluid and emitters, bodies, with their spin over the tank's diagonal),
 // twice the fastest collider (a wall moving at V throws what it meets at up to 2 V), the attractor's pull
 // (sqrt(strength radius), the speed of a fall into it) and its own speed, a free fall across the tank's diagonal
 // (sqrt(2 g L)), and the method's own push (a spacing each of FluidMethod::pushesPerFrame). Stable runs stay

@@ -30,10 +30,10 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const Collider
 
 template <int Dim>
 void WcsphSolver<Dim>::resizeChannels(size_t n) {
-  a_.assign(n, VecD::Zero());
-  density_.assign(n, restDensity_);
-  pressure_.assign(n, 0.0f);
-  if (nearStiffness_ > 0) nearPressure_.assign(n, 0.0f);
+  sizeChannel(a_, n, VecD(VecD::Zero()));
+  sizeChannel(density_, n, restDensity_);
+  sizeChannel(pressure_, n, 0.0f);
+  if (nearStiffness_ > 0) sizeChannel(nearPressure_, n, 0.0f);
   colliderForces_.assign(colliders_.size(), Wrench{});
   accelerationsValid_ = false;
 }

@@ -146,8 +146,10 @@ TEST(StudyCommand, StatsCarryFrontAndBackHeightOfTheDamBreak) {
     const auto rows = readCsv(out / "stats.csv");
     ASSERT_EQ(rows.size(), 12u);
     const int front = column(rows[0], "front_x"), height = column(rows[0], "back_height");
-    ASSERT_EQ(front, int(rows[0].size()) - 2);  // appended at the end: earlier columns keep their positions
-    ASSERT_EQ(height, int(rows[0].size()) - 1);
+    // Appended after the columns before them (which keep their positions), and before later ones (emitted).
+    ASSERT_EQ(front, column(rows[0], "divergence_iterations") + 1);
+    ASSERT_EQ(height, front + 1);
+    ASSERT_EQ(column(rows[0], "emitted"), height + 1);
     EXPECT_NEAR(std::stod(rows[1][front]), 0.4, 1e-6) << side;
     EXPECT_NEAR(std::stod(rows[1][height]), 0.4, 1e-6) << side;
     EXPECT_GT(std::stod(rows[11][front]), 0.6) << side;   // 1/3 s: the front has run about 2 column heights

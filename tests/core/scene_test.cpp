@@ -101,13 +101,73 @@ TEST(Scene, EveryBadInputIsOneLineNamingFileAndKey) {
             std::string::npos);
   EXPECT_NE(errorFor("/fluids/0/box/max", {0.01, 0.5, 0.5}).find("fluids: the fluid boxes hold no particles"),
             std::string::npos);
-  EXPECT_NE(errorFor("/fluids", nlohmann::json::array()).find("fluids: must not be empty"), std::string::npos);
+  EXPECT_NE(errorFor("/fluids", nlohmann::json::array()).find("fluids: the scene has no fluid"), std::string::npos);
   EXPECT_NE(errorFor("/domain/min", {0, 0}).find("domain.min: expected an array of 3 numbers"), std::string::npos);
   EXPECT_NE(errorFor("/dimensions", 4).find("dimensions: 4 is out of range"), std::string::npos);
   EXPECT_NE(errorFor("/domain/max", {1, 0, 0.5}).find("domain: min must be below max"), std::string::npos);
   EXPECT_NE(errorFor("/solver/kernel_radius", 0.04).find("solver.kernel_radius: must exceed"), std::string::npos);
   EXPECT_NE(errorFor("/surface/voxel_size", 1e-8).find("surface.voxel_size: the domain reaches more than 2^22"),
             std::string::npos);
+}
+
+// Emitters, sinks, open faces and shaped fluids: the keys issue 31 names, read, resolved and refused.
+TEST(Scene, SourcesAndShapedFluidsAreReadAndCheckedByKey) {
+  const nlohmann::json emitter = {{"position", {0.5, 0.9, 0.25}}, {"direction", {0, -2, 0}}, {"radius", 0.1},
+                                  {"speed", 2}};
+  nlohmann::json json = nlohmann::json::parse(kValid);
+  json["fluids"] = nlohmann::json::array();
+  json["emitters"] = {emitter};
+  json["sinks"] = {{{"shape", "sphere"}, {"position", {0.5, 0.1, 0.25}}, {"radius", 0.1}}};
+  json["domain"]["open"] = {"+x", "-z"};
+  const Scene scene = parseScene(json.dump(), "scene.json");
+  ASSERT_EQ(scene.emitters.size(), 1u);
+  EXPECT_EQ(scene.emitters[0].name, "emitter0");
+  EXPECT_EQ(scene.emitters[0].shape, "disc");
+  EXPECT_DOUBLE_EQ(scene.emitters[0].stop, 0);  // never
+  EXPECT_EQ(scene.sinks.at(0).name, "sink0");
+  EXPECT_EQ(scene.open, (std::vector<std::string>{"+x", "-z"}));
+  // scene.json reads back the same.
+  const Scene again = parseScene(sceneToJson(scene), "scene.json");
+  EXPECT_EQ(sceneToJson(again), sceneToJson(scene));
+
+  auto error = [&](const std::string& pointer, const nlohmann::json& value) {
+    nlohmann::json edited = json;
+    edited[nlohmann::json::json_pointer(pointer)] = value;
+    try {
+      parseScene(edited.dump(), "scene.json");
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.exitStatus(), 2);
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(error("/emitters/0/direction", {0, 0, 0}), "scene.json: emitters[0].direction: must not be the zero vector");
+  EXPECT_EQ(error("/emitters/0/position", {0.5, 1.2, 0.25}), "scene.json: emitters[0].position: lies outside the tank");
+  EXPECT_EQ(error("/emitters/0/shape", "rectangle"),
+            "scene.json: emitters[0].size: a rectangle needs its [width, height], both > 0");
+  nlohmann::json late = emitter;
+  late["start"] = 1.0;
+  late["stop"] = 0.5;
+  EXPECT_EQ(error("/emitters", nlohmann::json::array({late})), "scene.json: emitters[0].stop: must be after start (or 0: never)");
+  EXPECT_EQ(error("/domain/open", {"+w"}), "scene.json: domain.open: '+w' is not one of: -x, +x, -y, +y, -z, +z");
+  EXPECT_EQ(error("/domain/open", {"+x", "+x"}), "scene.json: domain.open: '+x' is named twice");
+  EXPECT_EQ(error("/fluids", {{{"shape", "torus"}}}),
+            "scene.json: fluids[0].shape: 'torus' is not one of: box, sphere, capsule, cylinder, mesh");
+  EXPECT_EQ(error("/fluids", {{{"shape", "sphere"}, {"box", {{"min", {0, 0, 0}}, {"max", {1, 1, 0.5}}}}}}),
+            "scene.json: fluids[0].box: give the fluid a box or a shape, not both");
+  EXPECT_EQ(error("/fluids", {{{"shape", "sphere"}, {"position", {0.5, 0.5, 0.25}}, {"radius", 0.2}}}), "accepted");
+
+  nlohmann::json flat = json;
+  flat["dimensions"] = 2;
+  flat["domain"] = {{"min", {0, 0}}, {"max", {1, 1}}, {"open", {"-z"}}};
+  flat["emitters"] = {{{"position", {0.5, 0.9}}, {"direction", {0, -1}}}};
+  flat["sinks"] = nlohmann::json::array();
+  try {
+    parseScene(flat.dump(), "flat.json");
+    ADD_FAILURE() << "accepted -z in 2D";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "flat.json: domain.open: '-z' does not exist in 2D (faces -x, +x, -y, +y)");
+  }
 }
 
 // NaN, Infinity and -Infinity, as Python's json module writes them (JSON has neither), are named by their key,

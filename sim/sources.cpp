@@ -1,0 +1,276 @@
+#include "sim/sources.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.h"
+#include "sim/colliders.h"
+
+namespace surge {
+namespace {
+
+constexpr double kGoldenAngle = 2.399963229728653;  // pi (3 - sqrt 5): the sunflower's turn between sites
+
+// The keyframes' value at `time`, linear between them and held outside.
+template <typename Value, typename Read>
+Value interpolate(const std::vector<EmitterKeyframe>& keys, double time, Read read) {
+  if (time <= keys.front().time || keys.size() == 1) return read(keys.front());
+  if (time >= keys.back().time) return read(keys.back());
+  size_t k = 1;
+  while (keys[k].time < time) ++k;
+  const double span = keys[k].time - keys[k - 1].time;
+  const double f = span > 0 ? (time - keys[k - 1].time) / span : 1.0;
+  return (1 - f) * read(keys[k - 1]) + f * read(keys[k]);
+}
+
+}  // namespace
+
+EmitterSchedule::EmitterSchedule(const EmitterSettings& settings, double spacing, int dimensions)
+    : settings_(settings), dimensions_(dimensions) {
+  const double s = spacing, r = settings.radius;
+  if (dimensions == 2) {
+    const size_t n = std::max<long>(1, std::lround(2 * r / s));
+    for (size_t j = 0; j < n; ++j) sites_.emplace_back((j + 0.5) * 2 * r / double(n) - r, 0.0);
+    area_ = 2 * r;
+    reach_ = r;
+  } else if (settings.shape == "rectangle") {
+    const double w = settings.size[0], h = settings.size[1];
+    const size_t nw = std::max<long>(1, std::lround(w / s)), nh = std::max<long>(1, std::lround(h / s));
+    for (size_t j = 0; j < nh; ++j)
+      for (size_t i = 0; i < nw; ++i)
+        sites_.emplace_back((i + 0.5) * w / double(nw) - w / 2, (j + 0.5) * h / double(nh) - h / 2);
+    area_ = w * h;
+    reach_ = 0.5 * std::hypot(w, h);
+  } else {
+    area_ = M_PI * r * r;
+    const size_t n = std::max<long>(1, std::lround(area_ / (s * s)));
+    for (size_t j = 0; j < n; ++j) {
+      const double radius = r * std::sqrt((j + 0.5) / double(n)), angle = double(j) * kGoldenAngle;
+      sites_.emplace_back(radius * std::cos(angle), radius * std::sin(angle));
+    }
+    reach_ = r;
+  }
+  // A layer's volume is sites x s^d; over the face's area that is the distance between layers.
+  pitch_ = double(sites_.size()) * std::pow(s, dimensions) / area_;
+}
+
+double EmitterSchedule::keyedSpeed(double time) const {
+  if (settings_.motion.empty()) return settings_.speed;
+  return interpolate<double>(settings_.motion, time,
+                             [&](const EmitterKeyframe& k) { return k.speed < 0 ? settings_.speed : k.speed; });
+}
+
+// The speed is linear between keyframes: the trapezoid rule over each piece is exact.
+double EmitterSchedule::speedIntegral(double from, double to) const {
+  if (!(to > from)) return 0;
+  if (settings_.motion.empty()) return settings_.speed * (to - from);
+  double total = 0, at = from;
+  for (const EmitterKeyframe& k : settings_.motion)
+    if (k.time > at && k.time < to) {
+      total += 0.5 * (keyedSpeed(at) + keyedSpeed(k.time)) * (k.time - at);
+      at = k.time;
+    }
+  return total + 0.5 * (keyedSpeed(at) + keyedSpeed(to)) * (to - at);
+}
+
+double EmitterSchedule::pushed(double time) const {
+  const double end = settings_.stop > 0 ? std::min(time, settings_.stop) : time;
+  return speedIntegral(settings_.start, end);
+}
+
+size_t EmitterSchedule::layersBy(double time) const {
+  const double d = pushed(time);
+  return d > 0 ? size_t(std::ceil(d / pitch_)) : 0;
+}
+
+Eigen::Vector3d EmitterSchedule::position(double time) const {
+  if (settings_.motion.empty()) return settings_.position;
+  return interpolate<Eigen::Vector3d>(settings_.motion, time, [](const EmitterKeyframe& k) { return k.position; });
+}
+
+Eigen::Vector3d EmitterSchedule::direction(double time) const {
+  auto unit = [&](const Eigen::Vector3d& d) {
+    Eigen::Vector3d u = d;
+    if (dimensions_ == 2) u.z() = 0;
+    return u.norm() > 0 ? Eigen::Vector3d(u.normalized()) : Eigen::Vector3d::Zero();
+  };
+  const Eigen::Vector3d own = unit(settings_.direction);
+  if (settings_.motion.empty()) return own;
+  const Eigen::Vector3d d = unit(interpolate<Eigen::Vector3d>(
+      settings_.motion, time, [&](const EmitterKeyframe& k) { return k.direction.norm() > 0 ? unit(k.direction) : own; }));
+  return d.norm() > 0 ? d : own;
+}
+
+double EmitterSchedule::speed(double time) const {
+  if (time < settings_.start || (settings_.stop > 0 && time >= settings_.stop)) return 0;
+  return keyedSpeed(time);
+}
+
+Eigen::Vector3d EmitterSchedule::site(size_t j, const Eigen::Vector3d& centre, const Eigen::Vector3d& d) const {
+  if (dimensions_ == 2) return centre + sites_[j].x() * Eigen::Vector3d(-d.y(), d.x(), 0);
+  // Width along d x up (x when d is vertical), height along width x d.
+  Eigen::Vector3d u = d.cross(Eigen::Vector3d::UnitY());
+  u = u.norm() > 1e-9 ? Eigen::Vector3d(u.normalized()) : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d w = u.cross(d);
+  return centre + sites_[j].x() * u + sites_[j].y() * w;
+}
+
+template <int Dim>
+struct FluidSources<Dim>::Sink {
+  ColliderShape shape;
+  Pose pose;
+  Eigen::AlignedBox<float, Dim> bounds;  // in the world; everything for a plane
+};
+
+template <int Dim>
+FluidSources<Dim>::FluidSources(const Scene& scene, uint32_t firstId, double time)
+    : scene_(scene),
+      spacing_(static_cast<float>(scene.particle_spacing)),
+      domainMin_(scene.domain.min.template head<Dim>().template cast<float>()),
+      domainMax_(scene.domain.max.template head<Dim>().template cast<float>()),
+      nextId_(firstId) {
+  for (const std::string& face : scene.open) {
+    const int axis = face[1] - 'x';
+    openFaces_ |= 1 << (2 * axis + (face[0] == '+' ? 1 : 0));
+  }
+  for (const EmitterSettings& settings : scene.emitters) {
+    emitters_.emplace_back(settings, scene.particle_spacing, Dim);
+    layers_.push_back(emitters_.back().layersBy(time));
+    nextId_ += static_cast<uint32_t>(layers_.back() * emitters_.back().sitesPerLayer());
+  }
+  for (size_t i = 0; i < scene.sinks.size(); ++i) {
+    auto sink = std::make_unique<Sink>();
+    sink->shape = buildSolidShape(scene, scene.sinks[i], "sinks[" + std::to_string(i) + "]", false);
+    sink->pose = colliderPose(scene.sinks[i], 0.0);
+    if (sink->shape.kind == ShapeKind::Plane) {
+      sink->bounds.setEmpty();
+      sink->bounds.extend(Vec<Dim>::Constant(-INFINITY)).extend(Vec<Dim>::Constant(INFINITY));
+    } else {
+      sink->bounds.setEmpty();
+      for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector3f local = sink->shape.bounds.corner(Eigen::AlignedBox3f::CornerType(corner));
+        sink->bounds.extend(sink->pose.toWorld(local.cast<double>()).template head<Dim>().template cast<float>());
+      }
+    }
+    sinks_.push_back(std::move(sink));
+  }
+}
+
+template <int Dim>
+FluidSources<Dim>::~FluidSources() = default;
+
+template <int Dim>
+bool FluidSources<Dim>::inSink(const VecD& p) const {
+  for (const std::unique_ptr<Sink>& sink : sinks_) {
+    if (!sink->bounds.contains(p)) continue;
+    Eigen::Vector3d world = Eigen::Vector3d::Zero();
+    world.template head<Dim>() = p.template cast<double>();
+    const Eigen::Vector3f local = sink->pose.toLocal(world).template cast<float>();
+    if (sink->shape.distance(local) < 0) return true;
+  }
+  return false;
+}
+
+template <int Dim>
+bool FluidSources<Dim>::pastOpenFace(const VecD& p) const {
+  for (int k = 0; k < Dim; ++k) {
+    if ((openFaces_ >> (2 * k) & 1) && p[k] < domainMin_[k]) return true;
+    if ((openFaces_ >> (2 * k + 1) & 1) && p[k] > domainMax_[k]) return true;
+  }
+  return false;
+}
+
+template <int Dim>
+void FluidSources<Dim>::checkStart(const std::vector<VecD>& particles, const Colliders<Dim>& colliders) const {
+  for (size_t e = 0; e < emitters_.size(); ++e) {
+    const VecD centre = emitters_[e].position(0.0).template head<Dim>().template cast<float>();
+    for (size_t c = 0; c < colliders.size(); ++c) {
+      VecD normal;
+      if (colliders.distance(c, centre, normal) < 0) {
+        const size_t n = scene_.colliders.size();
+        const std::string& name = c < n ? scene_.colliders[c].name : scene_.bodies[c - n].solid.name;
+        throw InputError(scene_.source, "emitters[" + std::to_string(e) + "].position",
+                         "lies inside " + std::string(c < n ? "collider " : "body ") + name);
+      }
+    }
+  }
+  if (!sinks_.empty() && !particles.empty() &&
+      std::all_of(particles.begin(), particles.end(), [&](const VecD& p) { return inSink(p); }))
+    throw InputError(scene_.source, "sinks", "hold the whole initial fluid: nothing would be left to simulate");
+}
+
+template <int Dim>
+void FluidSources<Dim>::apply(FluidSolver<Dim>& solver, double time) {
+  edit_.clear();
+  const std::vector<VecD>& x = solver.positions();
+  const size_t n = x.size();
+  if (!sinks_.empty() || openFaces_ != 0)
+    for (size_t i = 0; i < n; ++i)
+      if (pastOpenFace(x[i]) || inSink(x[i])) edit_.remove.push_back(static_cast<uint32_t>(i));
+
+  const float s = spacing_, radius = 0.5f * s;
+  Colliders<Dim>& colliders = solver.colliders();
+  for (size_t e = 0; e < emitters_.size(); ++e) {
+    const EmitterSchedule& emitter = emitters_[e];
+    const size_t due = emitter.layersBy(time);
+    const double speed = emitter.speed(time);
+    if (!(speed > 0) && due == layers_[e]) continue;
+    const Eigen::Vector3d centre = emitter.position(time), direction = emitter.direction(time);
+    const VecD c = centre.template head<Dim>().template cast<float>(), d = direction.template head<Dim>().template cast<float>();
+    const VecD jet = static_cast<float>(speed) * d;
+    const double pushed = emitter.pushed(time);
+    const float pitch = static_cast<float>(emitter.pitch()), reach = static_cast<float>(emitter.reach());
+    const float farthest = static_cast<float>(pushed - double(layers_[e]) * emitter.pitch()) + s;
+    // The nozzle (a layer's depth in front of the face) steers what is in it; anything near the new layers'
+    // sites keeps them empty.
+    nearby_.clear();
+    for (size_t i = 0; i < n; ++i) {
+      const VecD r = x[i] - c;
+      const float along = r.dot(d);
+      if (along < -s || along > farthest) continue;
+      const float across = (r - along * d).norm();
+      if (across > reach + s) continue;
+      if (speed > 0 && along >= -radius && along <= pitch && across <= reach) {
+        edit_.steer.push_back(static_cast<uint32_t>(i));
+        edit_.steerVelocity.push_back(jet);
+      }
+      nearby_.push_back(static_cast<uint32_t>(i));
+    }
+    for (size_t k = layers_[e]; k < due; ++k) {
+      const Eigen::Vector3d front = centre + (pushed - double(k) * emitter.pitch()) * direction;
+      for (size_t j = 0; j < emitter.sitesPerLayer(); ++j) {
+        const uint32_t id = nextId_++;
+        const VecD p = emitter.site(j, front, direction).template head<Dim>().template cast<float>();
+        bool blocked = ((p - domainMin_).array() < radius).any() || ((domainMax_ - p).array() < radius).any();
+        for (size_t b = 0; b < colliders.size() && !blocked; ++b) {
+          VecD normal;
+          blocked = colliders.distance(b, p, normal) < radius;
+        }
+        for (size_t q = 0; q < nearby_.size() && !blocked; ++q)
+          blocked = (x[nearby_[q]] - p).squaredNorm() < radius * radius;
+        if (blocked || inSink(p)) continue;
+        edit_.addPosition.push_back(p);
+        edit_.addVelocity.push_back(jet);
+        edit_.addId.push_back(id);
+      }
+    }
+    layers_[e] = due;
+  }
+  emitted += edit_.addPosition.size();
+  removed += edit_.remove.size();
+  if (!edit_.empty()) solver.editParticles(edit_);
+}
+
+size_t mostEmittedParticles(const Scene& scene, double time) {
+  size_t total = 0;
+  for (const EmitterSettings& settings : scene.emitters) {
+    const EmitterSchedule emitter(settings, scene.particle_spacing, scene.dimensions);
+    total += emitter.layersBy(time) * emitter.sitesPerLayer();
+  }
+  return total;
+}
+
+template class FluidSources<2>;
+template class FluidSources<3>;
+
+}  // namespace surge
