@@ -72,6 +72,7 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   const std::shared_ptr<const ColliderShapes> shapes = buildColliderShapes(scene);
   for (const ColliderShape& shape : *shapes)
     if (!shape.note.empty()) say(options, "sim: " + shape.note);
+  checkSimulationStart(scene, shapes);
   if (!scene.bodies.empty()) {
     const RigidBodies check(scene, shapes);
     // The coupling is explicit (docs/bodies.md): one particle's push in one step can throw a body lighter than it.

@@ -222,7 +222,8 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.integer("substeps", s.solver.substeps,
               atLeast(0, "PBF: time steps per output frame (WCSPH chooses its own, see time_step; DFSPH takes at "
                          "least this many, from its CFL step); 0: 4, or more if the pool the fluid settles into is "
-                         "deep enough to need them (dt <= 0.9 particle_spacing / sqrt(g depth))", "", 100000));
+                         "deep enough to need them (dt <= 0.9 particle_spacing / sqrt(g depth)) or an emitter fast "
+                         "enough to (its jet moves at most half a spacing a step)", "", 100000));
     v.real("kernel_radius", s.solver.kernel_radius,
            atLeast(0, "SPH kernel radius h; 0 means 2 x particle_spacing", "m"));
     v.real("rest_density", s.solver.rest_density, positive("rest density rho_0", "kg/m^3"));

@@ -265,7 +265,26 @@ void addShapedFluid(const Scene& scene, size_t index, ParticleFrame& frame) {
     throw InputError(scene.source, key, "the shape holds no lattice site at particle_spacing " + formatNumber(s));
 }
 
+template <int Dim>
+void checkStart(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes) {
+  ParticleFrame initial = initialParticles(scene);  // refuses a shape that holds no site, an open mesh
+  if (!scene.hasSources()) return;
+  const std::unique_ptr<FluidSolver<Dim>> solver = makeFluidSolver<Dim>(scene, std::move(shapes));
+  if (hasSolids(scene)) removeParticlesInside(solver->colliders(), initial);
+  std::vector<Vec<Dim>> positions(initial.size());
+  for (size_t i = 0; i < initial.size(); ++i) positions[i] = initial.position[i].head<Dim>();
+  FluidSources<Dim>(scene, 0, 0.0).checkStart(positions, solver->colliders());
+}
+
 }  // namespace
+
+void checkSimulationStart(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes) {
+  const bool shaped =
+      std::any_of(scene.fluids.begin(), scene.fluids.end(), [](const FluidBlock& f) { return f.shaped(); });
+  if (!shaped && !scene.hasSources()) return;
+  if (scene.dimensions == 2) checkStart<2>(scene, std::move(shapes));
+  else checkStart<3>(scene, std::move(shapes));
+}
 
 DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame) {
   DamBreakMeasures m;

@@ -10,8 +10,15 @@
 
 namespace surge {
 
-// The particles of the scene's fluid boxes on the lattice of particle_spacing, at cell centres.
+// The particles of the scene's fluid boxes on the lattice of particle_spacing, at cell centres, and of its fluid
+// shapes, the tank's lattice sites inside them. InputError naming fluids[i] for a shape that holds no site or
+// cannot be built (an open mesh).
 ParticleFrame initialParticles(const Scene& scene);
+
+// What a run would refuse at its start, checked before anything is written (a scene with fluid shapes, emitters,
+// sinks or open faces): InputError for a fluid shape that holds nothing, an emitter inside a collider or a body,
+// sinks that hold the whole initial fluid.
+void checkSimulationStart(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes);
 
 struct SimulationSummary {
   int firstFrame = 0;  // the frame the run started from (0, or the frame it resumed from)

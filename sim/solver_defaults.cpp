@@ -63,9 +63,14 @@ int stableSubsteps(const Scene& scene) {
   return int(std::min(steps, 100000.0));
 }
 
+int emitterSubsteps(const Scene& scene) {
+  const double travel = 0.5 * scene.particle_spacing * scene.output.fps;  // half a spacing a step, per frame
+  return int(std::min(std::ceil(fastestEmitter(scene) / travel - 1e-9), 100000.0));
+}
+
 void resolveSolverDefaults(Scene& scene) {
   SolverSettings& solver = scene.solver;
-  if (solver.substeps == 0) solver.substeps = std::max(4, stableSubsteps(scene));
+  if (solver.substeps == 0) solver.substeps = std::max({4, stableSubsteps(scene), emitterSubsteps(scene)});
   if (solver.speed_of_sound == 0) {
     // Ten times the fastest the water can move by falling through the tank (or by its initial velocity):
     // density then varies by about 1% (Monaghan 1994).

@@ -24,8 +24,13 @@ size_t mostParticles(const Scene& scene);
 // back; near a spacing the layers pass through each other and the pool boils (docs/speed-accuracy.md).
 int stableSubsteps(const Scene& scene);
 
+// The fewest steps a frame with which the fastest emitter's jet moves at most half a spacing a step: faster,
+// PBF's corrections push the layer just emitted back onto the next one's sites, which then stay empty (a 1 m/s
+// inflow at spacing 0.01 delivered 90% of its flux at 4 steps a frame, all of it at 5; docs/sources.md).
+int emitterSubsteps(const Scene& scene);
+
 // Fills the solver keys the file left 0 (SolverDefaults, core/scene.h): solver.substeps to max(4,
-// stableSubsteps), speed_of_sound to ten times the fastest the water can move by falling through the tank,
+// stableSubsteps, emitterSubsteps), speed_of_sound to ten times the fastest the water can move by falling through the tank,
 // gas_constant to its square, and then the scene's method's own (FluidMethod::resolveDefaults).
 void resolveSolverDefaults(Scene& scene);
 

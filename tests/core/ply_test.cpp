@@ -13,8 +13,10 @@
 namespace surge {
 namespace {
 
+// A folder of the running test's own: ctest runs the tests of this file side by side, and one lists its folder.
 fs::path tempPath(const std::string& name) {
-  const fs::path dir = fs::path(testing::TempDir()) / "surge_ply_test";
+  const fs::path dir = fs::path(testing::TempDir()) /
+                       ("surge_ply_test_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()));
   fs::create_directories(dir);
   return dir / name;
 }
