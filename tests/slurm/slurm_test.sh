@@ -36,14 +36,15 @@ wait_for_jobs() {
   return 1
 }
 
-# 2,250 particles, 30 frames; a render of about a second a frame, so that a task can be caught mid-frame.
+# A tap opening at 0.1 s into an empty tank (frames 0 to 2 hold no particle), about 2,200 particles by frame 29;
+# a render of about a second a frame, so that a task can be caught mid-frame.
 cat >"$work/scene.json" <<'EOF'
 {
   "name": "slurm_small",
   "dimensions": 3,
   "domain": {"min": [0, 0, 0], "max": [0.6, 0.4, 0.3]},
   "particle_spacing": 0.02,
-  "fluids": [{"box": {"min": [0, 0, 0], "max": [0.2, 0.3, 0.3]}}],
+  "emitters": [{"position": [0.15, 0.35, 0.15], "direction": [0, -1, 0], "radius": 0.08, "speed": 1, "start": 0.1}],
   "output": {"fps": 30, "frames": 29},
   "render": {"width": 320, "height": 180, "samples": 48}
 }
