@@ -434,7 +434,24 @@ void applyOverride(json& root, const std::string& assignment, std::set<std::stri
 
 }  // namespace
 
-Scene parseScene(const std::string& text, const std::string& where, const std::vector<std::string>& overrides) {
+namespace {
+
+// Scene files name their meshes and images relative to themselves; the resolved scene (scene.json) holds them
+// absolute. Resolved before the scene is checked, since the simulator's defaults may read them (a fluid shape's
+// volume).
+void resolveFiles(Scene& scene, const fs::path& folder) {
+  auto resolve = [&](ColliderSettings& c) {
+    if (!c.file.empty() && fs::path(c.file).is_relative())
+      c.file = fs::absolute(folder / c.file).lexically_normal().string();
+  };
+  for (ColliderSettings& c : scene.colliders) resolve(c);
+  for (BodySettings& b : scene.bodies) resolve(b.solid);
+  for (FluidBlock& f : scene.fluids) resolve(f.solid);
+  for (ColliderSettings& c : scene.sinks) resolve(c);
+}
+
+Scene parseSceneIn(const std::string& text, const std::string& where, const std::vector<std::string>& overrides,
+                   const fs::path* folder) {
   json root = json::parse(text, nullptr, false);
   if (root.is_discarded()) {
     const std::string marked = markNonFiniteWords(text);
@@ -465,21 +482,21 @@ Scene parseScene(const std::string& text, const std::string& where, const std::v
   JsonReader reader(root, where, scene, overridden);
   visitScene(scene, reader);
   reader.finish();
-  validateScene(scene, where);
+  if (folder) resolveFiles(scene, *folder);
   scene.source = where;
+  validateScene(scene, where);
   return scene;
 }
 
+}  // namespace
+
+Scene parseScene(const std::string& text, const std::string& where, const std::vector<std::string>& overrides) {
+  return parseSceneIn(text, where, overrides, nullptr);
+}
+
 Scene loadScene(const fs::path& path, const std::vector<std::string>& overrides) {
-  Scene scene = parseScene(readTextFile(path), path.string(), overrides);
-  // Collider and body files are named relative to the scene file; the resolved scene (scene.json) holds them absolute.
-  auto resolve = [&](ColliderSettings& c) {
-    if (!c.file.empty() && fs::path(c.file).is_relative())
-      c.file = fs::absolute(path.parent_path() / c.file).lexically_normal().string();
-  };
-  for (ColliderSettings& c : scene.colliders) resolve(c);
-  for (BodySettings& b : scene.bodies) resolve(b.solid);
-  return scene;
+  const fs::path folder = path.parent_path();
+  return parseSceneIn(readTextFile(path), path.string(), overrides, &folder);
 }
 
 std::string sceneToJson(const Scene& scene) {

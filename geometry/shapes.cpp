@@ -187,7 +187,7 @@ void buildMesh(ColliderShape& s, const ShapeInput& in) {
                          " GB at a voxel of half particle_spacing; scale the mesh down or coarsen the spacing");
   if (!closed && in.body)
     throw InputError(where, fileKey,
-                     "'" + c.file + "' is open or non-manifold: a body needs a closed mesh for its volume");
+                     "'" + c.file + "' is open or non-manifold: a body or a fluid needs a closed mesh for its volume");
   if (!closed) {
     char line[256];
     std::snprintf(line, sizeof line, "is open or non-manifold: treated as a shell %.4g m thick", c.thickness);

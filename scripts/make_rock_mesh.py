@@ -20,6 +20,8 @@ import argparse
 import math
 import os
 
+from obj_mesh import centre_and_scale, check_closed_edges, signed_volume, write_obj
+
 
 class Lcg:
     """Numerical Recipes' 32-bit linear congruential generator: the same numbers on every machine."""
@@ -91,26 +93,6 @@ def make_noise(seed):
     return noise
 
 
-def signed_volume(vertices, faces):
-    volume = 0.0
-    for a, b, c in faces:
-        pa, pb, pc = vertices[a], vertices[b], vertices[c]
-        volume += (pa[0] * (pb[1] * pc[2] - pb[2] * pc[1]) - pa[1] * (pb[0] * pc[2] - pb[2] * pc[0]) +
-                   pa[2] * (pb[0] * pc[1] - pb[1] * pc[0]))
-    return volume / 6.0
-
-
-def check_closed_manifold(faces):
-    edges = {}
-    for a, b, c in faces:
-        for u, v in ((a, b), (b, c), (c, a)):
-            edges[(u, v)] = edges.get((u, v), 0) + 1
-    for (u, v), count in edges.items():
-        # Each directed edge once, and its twin once: closed, manifold and consistently wound.
-        if count != 1 or edges.get((v, u), 0) != 1:
-            raise SystemExit("internal error: the mesh is not closed and consistently wound")
-
-
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -134,31 +116,14 @@ def main():
             p = (p[0] * floor / p[1], floor, p[2] * floor / p[1])
         vertices.append(p)
 
-    # Centre the bounding box on the origin and make the largest extent 1.
-    low = [min(p[k] for p in vertices) for k in range(3)]
-    high = [max(p[k] for p in vertices) for k in range(3)]
-    centre = [(low[k] + high[k]) / 2 for k in range(3)]
-    extent = max(high[k] - low[k] for k in range(3))
-    vertices = [tuple((p[k] - centre[k]) / extent for k in range(3)) for p in vertices]
-
-    check_closed_manifold(faces)
-    volume = signed_volume(vertices, faces)
-    if volume <= 0:
-        raise SystemExit("internal error: the triangles are wound inwards")
-
-    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-    lines = ["# rock.obj: a procedural boulder made by scripts/make_rock_mesh.py (--subdivisions %d --seed %d)"
-             % (args.subdivisions, args.seed),
-             "# Surge authors, CC0 1.0. %d vertices, %d triangles, closed, outward winding, largest extent 1."
-             % (len(vertices), len(faces))]
-    lines += ["v %.6f %.6f %.6f" % p for p in vertices]
-    lines += ["f %d %d %d" % (a + 1, b + 1, c + 1) for a, b, c in faces]
-    with open(args.out, "w", newline="\n") as f:
-        f.write("\n".join(lines) + "\n")
-    size = [(high[k] - low[k]) / extent for k in range(3)]
-    print("wrote %s (%d vertices, %d triangles, %.3f x %.3f x %.3f, volume %.4f)"
-          % (os.path.normpath(args.out), len(vertices), len(faces), size[0], size[1], size[2], volume))
-
+    vertices, low, high, extent = centre_and_scale(vertices)
+    check_closed_edges(faces)
+    write_obj(args.out,
+              ["rock.obj: a procedural boulder made by scripts/make_rock_mesh.py (--subdivisions %d --seed %d)"
+               % (args.subdivisions, args.seed),
+               "Surge authors, CC0 1.0. %d vertices, %d triangles, closed, outward winding, largest extent 1."
+               % (len(vertices), len(faces))],
+              ["v %.6f %.6f %.6f" % p for p in vertices], faces, low, high, extent, signed_volume(vertices, faces))
 
 if __name__ == "__main__":
     main()

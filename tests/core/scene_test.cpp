@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include <nlohmann/json.hpp>
 
 #include "core/errors.h"
@@ -168,6 +170,20 @@ TEST(Scene, SourcesAndShapedFluidsAreReadAndCheckedByKey) {
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "flat.json: domain.open: '-z' does not exist in 2D (faces -x, +x, -y, +y)");
   }
+}
+
+// A fluid's and a sink's files are found beside the scene file, as colliders' are, before the scene is checked
+// (the simulator's defaults read a fluid mesh for its volume); scene.json holds them absolute.
+TEST(Scene, FluidAndSinkFilesAreRelativeToTheSceneFile) {
+  const fs::path folder = fs::path(testing::TempDir()) / "surge_scene_files";
+  fs::create_directories(folder);
+  nlohmann::json json = nlohmann::json::parse(kValid);
+  json["fluids"] = {{{"shape", "mesh"}, {"file", "blob.obj"}, {"position", {0.5, 0.5, 0.25}}}};
+  json["sinks"] = {{{"shape", "mesh"}, {"file", "drain.obj"}}};
+  std::ofstream(folder / "scene.json") << json.dump();
+  const Scene scene = loadScene(folder / "scene.json");
+  EXPECT_EQ(scene.fluids.at(0).solid.file, fs::absolute(folder / "blob.obj").lexically_normal().string());
+  EXPECT_EQ(scene.sinks.at(0).file, fs::absolute(folder / "drain.obj").lexically_normal().string());
 }
 
 // NaN, Infinity and -Infinity, as Python's json module writes them (JSON has neither), are named by their key,
