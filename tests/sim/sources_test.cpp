@@ -79,6 +79,42 @@ TEST(Sources, AnEmitterDeliversAreaTimesSpeed) {
   }
 }
 
+// An emitter's schedule is a function of time: keyframed speed, closed and opened again (SPlisHSPlasH #369: an
+// emitter whose speed went to zero never restarted), moved and turned by keyframes (#79).
+TEST(Sources, AnEmitterClosedByItsKeyframesOpensAgainAndMovesWithThem) {
+  EmitterSettings e;
+  e.position = Eigen::Vector3d(0.5, 0.5, 0);
+  e.direction = Eigen::Vector3d(0, -1, 0);
+  e.radius = 0.05;
+  e.speed = 2;
+  // 2 m/s, closing linearly to 0 at 1 s, shut until 2 s, then 1 m/s from 3 s on.
+  e.motion = {{0, Eigen::Vector3d(0.5, 0.5, 0), Eigen::Vector3d::Zero(), -1},
+              {1, Eigen::Vector3d(0.5, 0.5, 0), Eigen::Vector3d::Zero(), 0},
+              {2, Eigen::Vector3d(0.5, 0.5, 0), Eigen::Vector3d::Zero(), 0},
+              {3, Eigen::Vector3d(0.2, 0.5, 0), Eigen::Vector3d(1, 0, 0), 1}};
+  const EmitterSchedule emitter(e, 0.01, 2);
+  EXPECT_EQ(emitter.sitesPerLayer(), 10u);
+  EXPECT_DOUBLE_EQ(emitter.pitch(), 0.01);
+  EXPECT_NEAR(emitter.pushed(1.0), 1.0, 1e-12);   // the triangle under 2 m/s falling to 0
+  EXPECT_NEAR(emitter.pushed(2.0), 1.0, 1e-12);   // shut
+  EXPECT_EQ(emitter.speed(1.5), 0);
+  EXPECT_NEAR(emitter.pushed(3.0), 1.5, 1e-12);   // opening from 0 to 1 m/s over the third second
+  EXPECT_NEAR(emitter.pushed(5.0), 3.5, 1e-12);   // then 1 m/s
+  EXPECT_EQ(emitter.layersBy(1.5), emitter.layersBy(2.0));
+  EXPECT_GT(emitter.layersBy(2.5), emitter.layersBy(2.0));  // open again
+  EXPECT_NEAR(emitter.position(2.5).x(), 0.35, 1e-12);      // halfway from 0.5 to 0.2
+  EXPECT_NEAR(emitter.direction(3.5).x(), 1, 1e-12);        // turned to +x
+  EXPECT_NEAR(emitter.direction(2.5).norm(), 1, 1e-12);     // unit between the keyframes
+  // start and stop bound it: nothing before start, nothing more after stop.
+  e.motion.clear();
+  e.start = 0.5;
+  e.stop = 1.5;
+  const EmitterSchedule timed(e, 0.01, 2);
+  EXPECT_EQ(timed.layersBy(0.5), 0u);
+  EXPECT_EQ(timed.layersBy(1.5), timed.layersBy(9.0));
+  EXPECT_EQ(timed.layersBy(9.0), 200u);  // 2 m over a 0.01 pitch
+}
+
 // A free horizontal jet from height H lands where a projectile would: x = v sqrt(2 (H - y) / g) from the face
 // at every height y. The jet's internal forces cancel in its mean, so the particles in a band near the floor,
 // each against the projectile's x at its own height, agree on average; 5% of the range is the bound.
