@@ -26,6 +26,17 @@ void visitRotation(SceneVisitor& v, Rotation& r) {
   });
 }
 
+// Keyframes of a collider's or a sink's position and rotation.
+void visitMotion(SceneVisitor& v, ColliderSettings& c, const char* description) {
+  v.list(
+      "motion", info(description), [&] { return c.motion.size(); }, [&](size_t n) { c.motion.resize(n); },
+      [&](size_t i) {
+        v.real("time", c.motion[i].time, atLeast(0, "time of the keyframe", "s"));
+        v.vector("position", c.motion[i].position, required("position at that time", "m"));
+        visitRotation(v, c.motion[i].rotation);
+      });
+}
+
 // The keys colliders and bodies share: a shape, its placement, its look. A body takes no plane or heightfield,
 // its friction is its contacts' and its name defaults to body<i>.
 void visitSolid(SceneVisitor& v, ColliderSettings& c, bool body) {
@@ -66,15 +77,9 @@ void visitSolid(SceneVisitor& v, ColliderSettings& c, bool body) {
     v.real("thickness", c.thickness,
            atLeast(0, "mesh: the shell thickness given to an open or non-manifold mesh; 0 means particle_spacing",
                    "m"));
-    v.list(
-        "motion", info("keyframes of position and rotation, linearly interpolated (held before the first and "
-                       "after the last); empty: the collider stands still"),
-        [&] { return c.motion.size(); }, [&](size_t n) { c.motion.resize(n); },
-        [&](size_t i) {
-          v.real("time", c.motion[i].time, atLeast(0, "time of the keyframe", "s"));
-          v.vector("position", c.motion[i].position, required("position at that time", "m"));
-          visitRotation(v, c.motion[i].rotation);
-        });
+    visitMotion(v, c,
+                "keyframes of position and rotation, linearly interpolated (held before the first and after the "
+                "last); empty: the collider stands still");
   }
   if (body)
     v.real("friction", c.friction,
@@ -105,6 +110,10 @@ void visitShapeKeys(SceneVisitor& v, ColliderSettings& c, bool sink) {
   if (sink) v.vector("normal", c.normal, info("plane: the normal, pointing out of the sink (any length but 0)"));
   v.text("file", c.file, info("mesh: an OBJ or PLY (closed, for a fluid); heightfield: a PNG; relative to the scene "
                               "file"));
+  if (sink)
+    visitMotion(v, c,
+                "keyframes of position and rotation, linearly interpolated (held before the first and after the "
+                "last); empty: the sink stands still");
 }
 
 void visitEmitter(SceneVisitor& v, EmitterSettings& e) {

@@ -88,6 +88,15 @@ Eigen::Vector3d EmitterSchedule::position(double time) const {
   return interpolate<Eigen::Vector3d>(settings_.motion, time, [](const EmitterKeyframe& k) { return k.position; });
 }
 
+Eigen::Vector3d EmitterSchedule::velocity(double time) const {
+  const auto& keys = settings_.motion;
+  if (keys.size() < 2 || time <= keys.front().time || time >= keys.back().time) return Eigen::Vector3d::Zero();
+  size_t k = 1;
+  while (keys[k].time < time) ++k;
+  const double span = keys[k].time - keys[k - 1].time;
+  return span > 0 ? Eigen::Vector3d((keys[k].position - keys[k - 1].position) / span) : Eigen::Vector3d::Zero();
+}
+
 Eigen::Vector3d EmitterSchedule::direction(double time) const {
   auto unit = [&](const Eigen::Vector3d& d) {
     Eigen::Vector3d u = d;
@@ -117,9 +126,23 @@ Eigen::Vector3d EmitterSchedule::site(size_t j, const Eigen::Vector3d& centre, c
 
 template <int Dim>
 struct FluidSources<Dim>::Sink {
+  const ColliderSettings* settings;
   ColliderShape shape;
   Pose pose;
   Eigen::AlignedBox<float, Dim> bounds;  // in the world; everything for a plane
+
+  void place(double time) {
+    pose = colliderPose(*settings, time);
+    bounds.setEmpty();
+    if (shape.kind == ShapeKind::Plane) {
+      bounds.extend(Vec<Dim>::Constant(-INFINITY)).extend(Vec<Dim>::Constant(INFINITY));
+      return;
+    }
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3f local = shape.bounds.corner(Eigen::AlignedBox3f::CornerType(corner));
+      bounds.extend(pose.toWorld(local.cast<double>()).template head<Dim>().template cast<float>());
+    }
+  }
 };
 
 template <int Dim>
@@ -141,17 +164,8 @@ FluidSources<Dim>::FluidSources(const Scene& scene, uint32_t firstId, double tim
   for (size_t i = 0; i < scene.sinks.size(); ++i) {
     auto sink = std::make_unique<Sink>();
     sink->shape = buildSolidShape(scene, scene.sinks[i], "sinks[" + std::to_string(i) + "]", false);
-    sink->pose = colliderPose(scene.sinks[i], 0.0);
-    if (sink->shape.kind == ShapeKind::Plane) {
-      sink->bounds.setEmpty();
-      sink->bounds.extend(Vec<Dim>::Constant(-INFINITY)).extend(Vec<Dim>::Constant(INFINITY));
-    } else {
-      sink->bounds.setEmpty();
-      for (int corner = 0; corner < 8; ++corner) {
-        const Eigen::Vector3f local = sink->shape.bounds.corner(Eigen::AlignedBox3f::CornerType(corner));
-        sink->bounds.extend(sink->pose.toWorld(local.cast<double>()).template head<Dim>().template cast<float>());
-      }
-    }
+    sink->settings = &scene.sinks[i];
+    sink->place(time);
     sinks_.push_back(std::move(sink));
   }
 }
@@ -169,6 +183,12 @@ bool FluidSources<Dim>::inSink(const VecD& p) const {
     if (sink->shape.distance(local) < 0) return true;
   }
   return false;
+}
+
+template <int Dim>
+void FluidSources<Dim>::placeSinks(double time) {
+  for (const std::unique_ptr<Sink>& sink : sinks_)
+    if (isMoving(*sink->settings)) sink->place(time);
 }
 
 template <int Dim>
@@ -202,6 +222,7 @@ void FluidSources<Dim>::checkStart(const std::vector<VecD>& particles, const Col
 template <int Dim>
 void FluidSources<Dim>::apply(FluidSolver<Dim>& solver, double time) {
   edit_.clear();
+  placeSinks(time);
   const std::vector<VecD>& x = solver.positions();
   const size_t n = x.size();
   if (!sinks_.empty() || openFaces_ != 0)
@@ -217,7 +238,8 @@ void FluidSources<Dim>::apply(FluidSolver<Dim>& solver, double time) {
     if (!(speed > 0) && due == layers_[e]) continue;
     const Eigen::Vector3d centre = emitter.position(time), direction = emitter.direction(time);
     const VecD c = centre.template head<Dim>().template cast<float>(), d = direction.template head<Dim>().template cast<float>();
-    const VecD jet = static_cast<float>(speed) * d;
+    // The jet's velocity, and the emitter's own when its keyframes move it (a hose swept across).
+    const VecD jet = static_cast<float>(speed) * d + emitter.velocity(time).head<Dim>().template cast<float>();
     const double pushed = emitter.pushed(time);
     const float pitch = static_cast<float>(emitter.pitch()), reach = static_cast<float>(emitter.reach());
     const float farthest = static_cast<float>(pushed - double(layers_[e]) * emitter.pitch()) + s;

@@ -38,6 +38,8 @@ class EmitterSchedule {
   // Its position, unit direction and speed at `time`; the speed is 0 before start and after stop.
   Eigen::Vector3d position(double time) const;
   Eigen::Vector3d direction(double time) const;
+  // How fast its keyframes move it at `time` (0 standing still, and before the first and after the last).
+  Eigen::Vector3d velocity(double time) const;
   double speed(double time) const;
   // Site j of the face with the face at `centre` facing `direction` (unit).
   Eigen::Vector3d site(size_t j, const Eigen::Vector3d& centre, const Eigen::Vector3d& direction) const;
@@ -75,6 +77,7 @@ class FluidSources {
 
  private:
   bool inSink(const VecD& p) const;
+  void placeSinks(double time);  // the moving sinks' poses and bounds at `time`
   bool pastOpenFace(const VecD& p) const;
 
   struct Sink;
