@@ -222,6 +222,13 @@ struct Scene {
   size_t particleCount() const;
   // True when fluid can enter or leave: emitters, sinks or open faces.
   bool hasSources() const { return !emitters.empty() || !sinks.empty() || !open.empty(); }
+  // True when domain.open names the tank's face on `axis` (0 x, 1 y, 2 z), its upper side or its lower.
+  bool isOpen(int axis, bool upper) const {
+    const std::string face = std::string(upper ? "+" : "-") + char('x' + axis);
+    for (const std::string& name : open)
+      if (name == face) return true;
+    return false;
+  }
 };
 
 // A collider or a body as the simulation left it for the later stages: its mesh in the world at time 0 in

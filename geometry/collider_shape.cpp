@@ -133,6 +133,13 @@ ColliderShape buildBodyShape(const Scene& scene, size_t index) {
   return buildSolidShape(scene, scene.bodies.at(index).solid, "bodies[" + std::to_string(index) + "]", true);
 }
 
+Eigen::AlignedBox3d worldBounds(const ColliderShape& shape, const Pose& pose) {
+  Eigen::AlignedBox3d world;
+  for (int corner = 0; corner < 8; ++corner)
+    world.extend(pose.toWorld(shape.bounds.corner(Eigen::AlignedBox3f::CornerType(corner)).cast<double>()));
+  return world;
+}
+
 ColliderShape buildSolidShape(const Scene& scene, const ColliderSettings& c, const std::string& key, bool body) {
   const std::string where = scene.source.empty() ? "scene" : scene.source;
   const float spacing = float(scene.particle_spacing);
@@ -154,10 +161,7 @@ ColliderShape buildSolidShape(const Scene& scene, const ColliderSettings& c, con
 
   // A collider that the domain does not reach would do nothing: surely a mistake in the scene.
   if (s.kind != ShapeKind::Plane) {
-    const Pose pose = colliderPose(c, 0.0);
-    Eigen::AlignedBox3d world;
-    for (int corner = 0; corner < 8; ++corner)
-      world.extend(pose.toWorld(s.bounds.corner(Eigen::AlignedBox3f::CornerType(corner)).cast<double>()));
+    Eigen::AlignedBox3d world = worldBounds(s, colliderPose(c, 0.0));
     Eigen::AlignedBox3d domain(scene.domain.min, scene.domain.max);
     if (scene.dimensions == 2) {
       world.min().z() = std::min(world.min().z(), 0.0);

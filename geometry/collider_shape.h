@@ -11,6 +11,7 @@
 #include "core/ply.h"
 #include "core/scene.h"
 #include "geometry/distance_grid.h"
+#include "geometry/pose.h"
 #include "geometry/triangle_mesh.h"
 
 namespace surge {
@@ -59,6 +60,9 @@ class ColliderShape {
   // Bytes held (the mesh's distance grid, the heightfield and the drawing mesh).
   size_t memoryBytes() const;
 };
+
+// The world box holding a shape's bounds placed by `pose` (its eight corners placed).
+Eigen::AlignedBox3d worldBounds(const ColliderShape& shape, const Pose& pose);
 
 // Builds collider `index` of the scene, reading its file if it has one. Throws InputError naming the scene file
 // and the key: a missing or unreadable file, a mesh without triangles, a distance grid too large, a collider

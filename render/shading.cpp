@@ -466,23 +466,19 @@ float toneMap(float linear, float exposure) {
 
 std::vector<std::array<Eigen::Vector3f, 2>> tankEdges(const Scene& scene) {
   const Eigen::Vector3f lo = scene.domain.min.cast<float>(), hi = scene.domain.max.cast<float>();
-  auto open = [&](int axis, bool upper) {
-    const std::string face = std::string(upper ? "+" : "-") + char('x' + axis);
-    return std::find(scene.open.begin(), scene.open.end(), face) != scene.open.end();
-  };
   std::vector<std::array<Eigen::Vector3f, 2>> edges;
   if (scene.dimensions == 2) {
     const Eigen::Vector3f a(lo.x(), hi.y(), 0), b(lo.x(), lo.y(), 0), c(hi.x(), lo.y(), 0), d(hi.x(), hi.y(), 0);
-    if (!open(0, false)) edges.push_back({a, b});
-    if (!open(1, false)) edges.push_back({b, c});
-    if (!open(0, true)) edges.push_back({c, d});
+    if (!scene.isOpen(0, false)) edges.push_back({a, b});
+    if (!scene.isOpen(1, false)) edges.push_back({b, c});
+    if (!scene.isOpen(0, true)) edges.push_back({c, d});
     return edges;
   }
   for (int axis = 0; axis < 3; ++axis) {
     const int a = (axis + 1) % 3, b = (axis + 2) % 3;
     for (int corner = 0; corner < 4; ++corner) {
       // The edge along `axis` lies on face a (upper when corner & 1) and face b (upper when corner & 2).
-      if (open(a, corner & 1) || open(b, corner & 2)) continue;
+      if (scene.isOpen(a, corner & 1) || scene.isOpen(b, corner & 2)) continue;
       Eigen::Vector3f p0 = lo, p1 = hi;
       p0[a] = p1[a] = (corner & 1) ? hi[a] : lo[a];
       p0[b] = p1[b] = (corner & 2) ? hi[b] : lo[b];

@@ -186,8 +186,7 @@ RayScene::RayScene(const RayDevice& device, const TriangleMesh& water, const Sce
     for (int axis : {0, 2}) {
       const int across = 2 - axis;  // the other horizontal axis
       for (float at : {outerLo[axis], outerHi[axis]}) {
-        const std::string face = std::string(at == outerHi[axis] ? "+" : "-") + char('x' + axis);
-        if (std::find(scene.open.begin(), scene.open.end(), face) != scene.open.end()) continue;  // no pane
+        if (scene.isOpen(axis, at == outerHi[axis])) continue;  // an open face has no pane
         const auto base = static_cast<uint32_t>(glass.positions.size());
         for (int corner = 0; corner < 4; ++corner) {
           Eigen::Vector3f p;

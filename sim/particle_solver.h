@@ -47,9 +47,9 @@ void tankWallBox(const Scene& scene, Vec<Dim>& lower, Vec<Dim>& upper) {
   lower = toVec<Dim>(scene.domain.min);
   upper = toVec<Dim>(scene.domain.max);
   const float margin = 2 * static_cast<float>(scene.solver.kernel_radius);
-  for (const std::string& face : scene.open) {
-    const int axis = face[1] - 'x';
-    if (axis < Dim) (face[0] == '-' ? lower[axis] -= margin : upper[axis] += margin);
+  for (int axis = 0; axis < Dim; ++axis) {
+    if (scene.isOpen(axis, false)) lower[axis] -= margin;
+    if (scene.isOpen(axis, true)) upper[axis] += margin;
   }
 }
 

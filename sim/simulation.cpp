@@ -81,9 +81,9 @@ template <int Dim>
 uint32_t startParticles(const Scene& scene, const fs::path& dir, bool resume, FluidSolver<Dim>& solver,
                         RigidBodies* bodies, SimulationSummary& summary) {
   const std::vector<int> existing = resume ? listFrames(dir, "particles", "ply") : std::vector<int>{};
-  ParticleFrame initial = initialParticles(scene);
-  const auto firstEmittedId = static_cast<uint32_t>(initial.size());
   if (existing.empty()) {
+    ParticleFrame initial = initialParticles(scene);
+    const auto firstEmittedId = static_cast<uint32_t>(initial.size());
     if (!scene.colliders.empty() || bodies) {
       summary.removedParticles = removeParticlesInside(solver.colliders(), initial);
       if (initial.size() == 0 && scene.emitters.empty())
@@ -102,7 +102,8 @@ uint32_t startParticles(const Scene& scene, const fs::path& dir, bool resume, Fl
   if (carried > 0 && summary.firstFrame < scene.output.frames)
     solver.restoreCarriedState(readCarriedState(dir, summary.firstFrame, carried));
   if (bodies) bodies->setStates(readBodyStates(framePath(dir, "bodies", summary.firstFrame, "txt"), scene));
-  return firstEmittedId;
+  // A resumed run's emitters go on from the initial lattice's count; without emitters it is not needed.
+  return scene.emitters.empty() ? 0 : static_cast<uint32_t>(initialParticles(scene).size());
 }
 
 // The frame loop, for any solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
@@ -237,9 +238,7 @@ void addShapedFluid(const Scene& scene, size_t index, ParticleFrame& frame) {
   const std::string key = "fluids[" + std::to_string(index) + "]";
   const ColliderShape shape = buildSolidShape(scene, fluid.solid, key, true);
   const Pose pose = colliderPose(fluid.solid, 0.0);
-  Eigen::AlignedBox3d world;
-  for (int corner = 0; corner < 8; ++corner)
-    world.extend(pose.toWorld(shape.bounds.corner(Eigen::AlignedBox3f::CornerType(corner)).cast<double>()));
+  const Eigen::AlignedBox3d world = worldBounds(shape, pose);
   const double s = scene.particle_spacing;
   Eigen::Array3i lo(0, 0, 0), hi(0, 0, 0);
   for (int k = 0; k < scene.dimensions; ++k) {

@@ -28,10 +28,11 @@ Value interpolate(const std::vector<EmitterKeyframe>& keys, double time, Read re
 EmitterSchedule::EmitterSchedule(const EmitterSettings& settings, double spacing, int dimensions)
     : settings_(settings), dimensions_(dimensions) {
   const double s = spacing, r = settings.radius;
+  double area = 0;  // of the face (m^2, or m in 2D)
   if (dimensions == 2) {
     const size_t n = std::max<long>(1, std::lround(2 * r / s));
     for (size_t j = 0; j < n; ++j) sites_.emplace_back((j + 0.5) * 2 * r / double(n) - r, 0.0);
-    area_ = 2 * r;
+    area = 2 * r;
     reach_ = r;
   } else if (settings.shape == "rectangle") {
     const double w = settings.size[0], h = settings.size[1];
@@ -39,11 +40,11 @@ EmitterSchedule::EmitterSchedule(const EmitterSettings& settings, double spacing
     for (size_t j = 0; j < nh; ++j)
       for (size_t i = 0; i < nw; ++i)
         sites_.emplace_back((i + 0.5) * w / double(nw) - w / 2, (j + 0.5) * h / double(nh) - h / 2);
-    area_ = w * h;
+    area = w * h;
     reach_ = 0.5 * std::hypot(w, h);
   } else {
-    area_ = M_PI * r * r;
-    const size_t n = std::max<long>(1, std::lround(area_ / (s * s)));
+    area = M_PI * r * r;
+    const size_t n = std::max<long>(1, std::lround(area / (s * s)));
     for (size_t j = 0; j < n; ++j) {
       const double radius = r * std::sqrt((j + 0.5) / double(n)), angle = double(j) * kGoldenAngle;
       sites_.emplace_back(radius * std::cos(angle), radius * std::sin(angle));
@@ -51,7 +52,7 @@ EmitterSchedule::EmitterSchedule(const EmitterSettings& settings, double spacing
     reach_ = r;
   }
   // A layer's volume is sites x s^d; over the face's area that is the distance between layers.
-  pitch_ = double(sites_.size()) * std::pow(s, dimensions) / area_;
+  pitch_ = double(sites_.size()) * std::pow(s, dimensions) / area;
 }
 
 double EmitterSchedule::keyedSpeed(double time) const {
@@ -138,10 +139,9 @@ struct FluidSources<Dim>::Sink {
       bounds.extend(Vec<Dim>::Constant(-INFINITY)).extend(Vec<Dim>::Constant(INFINITY));
       return;
     }
-    for (int corner = 0; corner < 8; ++corner) {
-      const Eigen::Vector3f local = shape.bounds.corner(Eigen::AlignedBox3f::CornerType(corner));
-      bounds.extend(pose.toWorld(local.cast<double>()).template head<Dim>().template cast<float>());
-    }
+    const Eigen::AlignedBox3d world = worldBounds(shape, pose);
+    bounds.extend(world.min().template head<Dim>().template cast<float>());
+    bounds.extend(world.max().template head<Dim>().template cast<float>());
   }
 };
 
@@ -152,10 +152,9 @@ FluidSources<Dim>::FluidSources(const Scene& scene, uint32_t firstId, double tim
       domainMin_(scene.domain.min.template head<Dim>().template cast<float>()),
       domainMax_(scene.domain.max.template head<Dim>().template cast<float>()),
       nextId_(firstId) {
-  for (const std::string& face : scene.open) {
-    const int axis = face[1] - 'x';
-    openFaces_ |= 1 << (2 * axis + (face[0] == '+' ? 1 : 0));
-  }
+  for (int axis = 0; axis < Dim; ++axis)
+    for (int upper = 0; upper < 2; ++upper)
+      if (scene.isOpen(axis, upper)) openFaces_ |= 1 << (2 * axis + upper);
   for (const EmitterSettings& settings : scene.emitters) {
     emitters_.emplace_back(settings, scene.particle_spacing, Dim);
     layers_.push_back(emitters_.back().layersBy(time));

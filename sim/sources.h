@@ -30,7 +30,6 @@ class EmitterSchedule {
 
   size_t sitesPerLayer() const { return sites_.size(); }
   double pitch() const { return pitch_; }
-  double area() const { return area_; }
   // D(t): how far the emitter has pushed fluid by `time` (m).
   double pushed(double time) const;
   // Layers that have left by `time`: those k with k pitch < D(time).
@@ -52,7 +51,7 @@ class EmitterSchedule {
   EmitterSettings settings_;
   int dimensions_;
   std::vector<Eigen::Vector2d> sites_;  // in the face's (u, w) plane
-  double pitch_ = 0, area_ = 0, reach_ = 0;
+  double pitch_ = 0, reach_ = 0;
 };
 
 template <int Dim>
@@ -64,8 +63,6 @@ class FluidSources {
   // starts (0, or the frame it resumes from). InputError for a sink that cannot be built.
   FluidSources(const Scene& scene, uint32_t firstId, double time);
   ~FluidSources();
-
-  bool empty() const { return emitters_.empty() && sinks_.empty() && openFaces_ == 0; }
 
   // At the start of a fresh run: InputError when an emitter's centre lies inside a collider or a body, or the
   // sinks hold every particle of the initial fluid.
