@@ -22,12 +22,13 @@
 namespace surge {
 
 // Particles entering and leaving between two steps (sim/sources.h): the indices (in the solver's current order)
-// to remove, in increasing order; particles given a new velocity (an emitter's nozzle); and new particles.
+// to remove, in increasing order; particles given a new position and velocity (an emitter's nozzle); and new
+// particles.
 template <int Dim>
 struct ParticleEdit {
   std::vector<uint32_t> remove;
   std::vector<uint32_t> steer;
-  std::vector<Vec<Dim>> steerVelocity;
+  std::vector<Vec<Dim>> steerPosition, steerVelocity;
   std::vector<Vec<Dim>> addPosition, addVelocity;
   std::vector<uint32_t> addId;
 
@@ -35,6 +36,7 @@ struct ParticleEdit {
   void clear() {
     remove.clear();
     steer.clear();
+    steerPosition.clear();
     steerVelocity.clear();
     addPosition.clear();
     addVelocity.clear();

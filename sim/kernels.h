@@ -14,6 +14,12 @@ namespace surge {
 template <int Dim>
 using Vec = Eigen::Matrix<float, Dim, 1>;
 
+// A scene's vector (double, 3D) as the solver's.
+template <int Dim>
+Vec<Dim> toVec(const Eigen::Vector3d& v) {
+  return v.head<Dim>().template cast<float>();
+}
+
 template <int Dim>
 class Kernels {
  public:

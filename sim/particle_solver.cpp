@@ -61,8 +61,12 @@ void ParticleSolver<Dim>::getParticles(ParticleFrame& frame) const {
 
 template <int Dim>
 void ParticleSolver<Dim>::editParticles(const ParticleEdit<Dim>& edit) {
-  for (size_t k = 0; k < edit.steer.size(); ++k) v_[edit.steer[k]] = edit.steerVelocity[k];
-  if (edit.remove.empty() && edit.addPosition.empty()) return;
+  for (size_t k = 0; k < edit.steer.size(); ++k) {
+    x_[edit.steer[k]] = edit.steerPosition[k];
+    v_[edit.steer[k]] = edit.steerVelocity[k];
+  }
+  // Even with no particle added or removed, a moved one makes what the method derived from x_ stale.
+  if (edit.remove.empty() && edit.addPosition.empty() && edit.steer.empty()) return;
   const size_t before = x_.size();
   // The survivors move down over the removed, in order, with their carried channels.
   auto compact = [&](auto& channel) {

@@ -26,11 +26,6 @@
 
 namespace surge {
 
-template <int Dim>
-Vec<Dim> toVec(const Eigen::Vector3d& v) {
-  return v.head<Dim>().template cast<float>();
-}
-
 // Sizes a channel to n values, growing its capacity by half at least, so that a count that keeps growing (an
 // emitter's) reallocates rarely.
 template <typename T>

@@ -9,6 +9,8 @@
 namespace surge {
 namespace {
 
+constexpr double kNozzleLayers = 2;     // the nozzle's depth, in layers (docs/sources.md)
+constexpr float kIntruderStep = 0.5f;  // the farthest a step moves water out of a nozzle, in spacings
 constexpr double kGoldenAngle = 2.399963229728653;  // pi (3 - sqrt 5): the sunflower's turn between sites
 
 // The keyframes' value at `time`, linear between them and held outside.
@@ -151,6 +153,7 @@ FluidSources<Dim>::FluidSources(const Scene& scene, uint32_t firstId, double tim
       spacing_(static_cast<float>(scene.particle_spacing)),
       domainMin_(scene.domain.min.template head<Dim>().template cast<float>()),
       domainMax_(scene.domain.max.template head<Dim>().template cast<float>()),
+      gravity_(scene.gravity),
       nextId_(firstId) {
   for (int axis = 0; axis < Dim; ++axis)
     for (int upper = 0; upper < 2; ++upper)
@@ -218,6 +221,106 @@ void FluidSources<Dim>::checkStart(const std::vector<VecD>& particles, const Col
     throw InputError(scene_.source, "sinks", "hold the whole initial fluid: nothing would be left to simulate");
 }
 
+// Emitter e's part of the edit after the step that ended at `time`: its nozzle held, and the layers it owes.
+template <int Dim>
+void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
+  const EmitterSchedule& emitter = emitters_[e];
+  const size_t due = emitter.layersBy(time);
+  const double speed = emitter.speed(time);
+  if (!(speed > 0) && due == layers_[e]) return;
+  const std::vector<VecD>& x = solver.positions();
+  const float s = spacing_, radius = 0.5f * s;
+  const Eigen::Vector3d centre = emitter.position(time), direction = emitter.direction(time);
+  const VecD c = toVec<Dim>(centre), d = toVec<Dim>(direction);
+  // The jet's velocity, and the emitter's own when its keyframes move it (a hose swept across).
+  const Eigen::Vector3d jet = speed * direction + emitter.velocity(time);
+  const double pushed = emitter.pushed(time), pitch = emitter.pitch();
+  // Where site j of the layer `offset` in front of the face is, and how fast it moves: in free flight since it
+  // left the face, so that holding a jet into air in its nozzle changes nothing.
+  auto nozzleSite = [&](double offset, size_t j, VecD& velocity) {
+    const double flight = speed > 0 ? std::max(0.0, offset) / speed : 0.0;
+    velocity = toVec<Dim>(jet + flight * gravity_);
+    return toVec<Dim>(emitter.site(j, centre + offset * direction, direction) + 0.5 * flight * flight * gravity_);
+  };
+
+  // The nozzle, kNozzleLayers layers in front of the face, is a pipe while the emitter runs: each particle of a
+  // layer in it rides its site whatever the solver did, and anything else in it (water drawn in from behind or
+  // the sides) is moved out the nearest way. The water in front is then pushed as by a piston, and the next
+  // layer's sites are free (docs/sources.md).
+  const float reach = static_cast<float>(emitter.reach()), depth = static_cast<float>(kNozzleLayers * pitch);
+  const size_t sites = emitter.sitesPerLayer();
+  const size_t heldFrom =
+      std::min(layers_[e], static_cast<size_t>(std::max(0.0, std::ceil((pushed - kNozzleLayers * pitch) / pitch))));
+  held_.assign((layers_[e] - heldFrom) * sites, 0);
+  const float farthest = std::max(static_cast<float>(pushed - double(layers_[e]) * pitch), depth) + s;
+  nearby_.clear();
+  for (size_t i = 0; i < x.size(); ++i) {
+    const VecD r = x[i] - c;
+    const float along = r.dot(d);
+    if (along < -s || along > farthest) continue;
+    const float across = (r - along * d).norm();
+    if (across > reach + s) continue;
+    VecD at = x[i];
+    if (speed > 0 && along > -radius && along < depth + radius && across < reach + radius) {
+      const long k = std::lround((pushed - double(along)) / pitch);
+      bool held = k < long(heldFrom);  // a layer that has left the nozzle goes its own way
+      if (k >= long(heldFrom) && k < long(layers_[e])) {
+        const double offset = pushed - double(k) * pitch;
+        size_t nearest = 0;
+        float best = INFINITY;
+        VecD velocity;
+        for (size_t j = 0; j < sites; ++j) {
+          const float d2 = (nozzleSite(offset, j, velocity) - x[i]).squaredNorm();
+          if (d2 < best) best = d2, nearest = j;
+        }
+        uint8_t& taken = held_[(size_t(k) - heldFrom) * sites + nearest];
+        if (best < radius * radius && !taken) {
+          taken = 1;
+          held = true;
+          at = nozzleSite(offset, nearest, velocity);
+          edit_.steer.push_back(static_cast<uint32_t>(i));
+          edit_.steerPosition.push_back(at);
+          edit_.steerVelocity.push_back(velocity);
+        }
+      }
+      if (!held) {
+        // At most kIntruderStep spacings a step: water standing where a nozzle opens (a submerged emitter's
+        // start) clears over a few steps without piling onto what is around it.
+        const float most = kIntruderStep * s;
+        const float back = along + radius, side = reach + radius - across, ahead = depth + radius - along;
+        if (back <= side && back <= ahead) at -= std::min(back, most) * d;
+        else if (ahead <= side) at += std::min(ahead, most) * d;
+        else at += std::min(side, most) * (across > 0 ? VecD((r - along * d) / across) : VecD(VecD::Unit(Dim - 1)));
+        edit_.steer.push_back(static_cast<uint32_t>(i));
+        edit_.steerPosition.push_back(at);
+        edit_.steerVelocity.push_back(solver.velocities()[i]);
+      }
+    }
+    nearby_.push_back(at);
+  }
+
+  // The layers due by now, each site unless it is blocked.
+  Colliders<Dim>& colliders = solver.colliders();
+  for (size_t k = layers_[e]; k < due; ++k)
+    for (size_t j = 0; j < sites; ++j) {
+      const uint32_t id = nextId_++;
+      VecD velocity;
+      const VecD p = nozzleSite(pushed - double(k) * pitch, j, velocity);
+      bool blocked = ((p - domainMin_).array() < radius).any() || ((domainMax_ - p).array() < radius).any();
+      for (size_t b = 0; b < colliders.size() && !blocked; ++b) {
+        VecD normal;
+        blocked = colliders.distance(b, p, normal) < radius;
+      }
+      for (size_t q = 0; q < nearby_.size() && !blocked; ++q)
+        blocked = (nearby_[q] - p).squaredNorm() < radius * radius;
+      if (blocked || inSink(p)) continue;
+      edit_.addPosition.push_back(p);
+      edit_.addVelocity.push_back(velocity);
+      edit_.addId.push_back(id);
+    }
+  layers_[e] = due;
+}
+
 template <int Dim>
 void FluidSources<Dim>::apply(FluidSolver<Dim>& solver, double time) {
   edit_.clear();
@@ -228,55 +331,7 @@ void FluidSources<Dim>::apply(FluidSolver<Dim>& solver, double time) {
     for (size_t i = 0; i < n; ++i)
       if (pastOpenFace(x[i]) || inSink(x[i])) edit_.remove.push_back(static_cast<uint32_t>(i));
 
-  const float s = spacing_, radius = 0.5f * s;
-  Colliders<Dim>& colliders = solver.colliders();
-  for (size_t e = 0; e < emitters_.size(); ++e) {
-    const EmitterSchedule& emitter = emitters_[e];
-    const size_t due = emitter.layersBy(time);
-    const double speed = emitter.speed(time);
-    if (!(speed > 0) && due == layers_[e]) continue;
-    const Eigen::Vector3d centre = emitter.position(time), direction = emitter.direction(time);
-    const VecD c = centre.template head<Dim>().template cast<float>(), d = direction.template head<Dim>().template cast<float>();
-    // The jet's velocity, and the emitter's own when its keyframes move it (a hose swept across).
-    const VecD jet = static_cast<float>(speed) * d + emitter.velocity(time).head<Dim>().template cast<float>();
-    const double pushed = emitter.pushed(time);
-    const float pitch = static_cast<float>(emitter.pitch()), reach = static_cast<float>(emitter.reach());
-    const float farthest = static_cast<float>(pushed - double(layers_[e]) * emitter.pitch()) + s;
-    // The nozzle (a layer's depth in front of the face) steers what is in it; anything near the new layers'
-    // sites keeps them empty.
-    nearby_.clear();
-    for (size_t i = 0; i < n; ++i) {
-      const VecD r = x[i] - c;
-      const float along = r.dot(d);
-      if (along < -s || along > farthest) continue;
-      const float across = (r - along * d).norm();
-      if (across > reach + s) continue;
-      if (speed > 0 && along >= -radius && along <= pitch && across <= reach) {
-        edit_.steer.push_back(static_cast<uint32_t>(i));
-        edit_.steerVelocity.push_back(jet);
-      }
-      nearby_.push_back(static_cast<uint32_t>(i));
-    }
-    for (size_t k = layers_[e]; k < due; ++k) {
-      const Eigen::Vector3d front = centre + (pushed - double(k) * emitter.pitch()) * direction;
-      for (size_t j = 0; j < emitter.sitesPerLayer(); ++j) {
-        const uint32_t id = nextId_++;
-        const VecD p = emitter.site(j, front, direction).template head<Dim>().template cast<float>();
-        bool blocked = ((p - domainMin_).array() < radius).any() || ((domainMax_ - p).array() < radius).any();
-        for (size_t b = 0; b < colliders.size() && !blocked; ++b) {
-          VecD normal;
-          blocked = colliders.distance(b, p, normal) < radius;
-        }
-        for (size_t q = 0; q < nearby_.size() && !blocked; ++q)
-          blocked = (x[nearby_[q]] - p).squaredNorm() < radius * radius;
-        if (blocked || inSink(p)) continue;
-        edit_.addPosition.push_back(p);
-        edit_.addVelocity.push_back(jet);
-        edit_.addId.push_back(id);
-      }
-    }
-    layers_[e] = due;
-  }
+  for (size_t e = 0; e < emitters_.size(); ++e) emit(e, solver, time);
   emitted += edit_.addPosition.size();
   removed += edit_.remove.size();
   if (!edit_.empty()) solver.editParticles(edit_);

@@ -73,6 +73,7 @@ class FluidSources {
   size_t emitted = 0, removed = 0;  // since the counts were last cleared
 
  private:
+  void emit(size_t e, FluidSolver<Dim>& solver, double time);
   bool inSink(const VecD& p) const;
   void placeSinks(double time);  // the moving sinks' poses and bounds at `time`
   bool pastOpenFace(const VecD& p) const;
@@ -81,13 +82,15 @@ class FluidSources {
   const Scene& scene_;
   float spacing_;
   VecD domainMin_, domainMax_;
+  Eigen::Vector3d gravity_;
   int openFaces_ = 0;  // bits: axis k's lower face 1 << 2k, upper 1 << (2k + 1)
   std::vector<EmitterSchedule> emitters_;
   std::vector<size_t> layers_;  // layers each emitter has made
   uint32_t nextId_;
   std::vector<std::unique_ptr<Sink>> sinks_;
   ParticleEdit<Dim> edit_;  // reused: no allocation once its capacity suffices
-  std::vector<uint32_t> nearby_;
+  std::vector<VecD> nearby_;    // where the particles near an emitter's face are after the edit
+  std::vector<uint8_t> held_;   // the nozzle's sites, by layer: 1 once a particle rides it
 };
 
 // The most particles the scene's emitters can make by `time` (every site filled): the memory check's count.
