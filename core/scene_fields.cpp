@@ -229,8 +229,9 @@ void visitScene(Scene& s, SceneVisitor& v) {
     if (methods.empty()) v.text("method", s.solver.method, info("the fluid method"));
     else v.choice("method", s.solver.method, methods, info(methodLines.c_str()));
     v.integer("substeps", s.solver.substeps,
-              atLeast(0, "PBF: time steps per output frame (WCSPH chooses its own, see time_step; DFSPH takes at "
-                         "least this many, from its CFL step); 0: 4, or more if the pool the fluid settles into is "
+              atLeast(0, "PBF: the fewest time steps per output frame, each shortened when the fluid needs it (the "
+                         "CFL step, and dt <= 0.9 particle_spacing / sqrt(g depth) on its deepest column); WCSPH "
+                         "chooses its own, see time_step; DFSPH takes at least this many, from its CFL step; 0: 4, or more if the pool the fluid settles into is "
                          "deep enough to need them (dt <= 0.9 particle_spacing / sqrt(g depth)) or an emitter fast "
                          "enough to (its jet moves at most half a spacing a step)", "", 100000));
     v.real("kernel_radius", s.solver.kernel_radius,
@@ -251,7 +252,7 @@ void visitScene(Scene& s, SceneVisitor& v) {
                       "force limits. DFSPH: the largest step (its CFL step may be shorter); 0 means one frame / "
                       "substeps", "s"));
     FieldInfo cfl = positive("Courant number. WCSPH: dt <= cfl h / (c + |v|max), h = kernel_radius / 2; DFSPH: "
-                             "dt <= cfl particle_spacing / |v|max");
+                             "dt <= cfl particle_spacing / |v|max; PBF: dt <= cfl kernel_radius / |v|max");
     cfl.max = 1;
     v.real("cfl", s.solver.cfl, cfl);
     for (const SolverMethodEntry& method : solverMethodCatalog())

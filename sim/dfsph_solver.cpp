@@ -54,13 +54,7 @@ void DfsphSolver<Dim>::beginFrame(double) {
 // The CFL condition on the fastest particle after a step's worth of gravity at most.
 template <int Dim>
 float DfsphSolver<Dim>::stableTimeStep() {
-  const VecD fall = maxStep_ * this->gravity_;
-  std::vector<float>& speeds = floatScratch_;
-  speeds.resize(size());
-  parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) speeds[i] = (v_[i] + fall).norm();
-  });
-  const float fastest = parallelMax(speeds);
+  const float fastest = this->fastestAfterFall(maxStep_);
   return fastest > 0 ? std::min(maxStep_, cfl_ * spacing_ / fastest) : maxStep_;
 }
 

@@ -57,8 +57,8 @@ class FluidSolver {
   virtual const std::vector<Vec<Dim>>& velocities() const = 0;
   virtual float particleMass() const = 0;
 
-  // Steps a frame: > 0 for a method that takes that many equal steps; 0 for one that chooses each step's
-  // length (stableTimeStep, read before every step).
+  // Steps a frame: > 0 for a method that takes at least that many equal steps, shorter ones when stableTimeStep
+  // (read before every step) is below them; 0 for one that chooses each step's length from stableTimeStep.
   virtual int fixedSubsteps() const = 0;
   virtual float stableTimeStep() = 0;
   // The start of an output frame at `time`. A method that keeps state between steps beyond positions and

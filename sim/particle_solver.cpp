@@ -103,6 +103,17 @@ void ParticleSolver<Dim>::editParticles(const ParticleEdit<Dim>& edit) {
   colliders_.resizeSlots(n);
 }
 
+template <int Dim>
+float ParticleSolver<Dim>::fastestAfterFall(float dt) {
+  const VecD fall = dt * gravity_;
+  std::vector<float>& speeds = floatScratch_;
+  speeds.resize(size());
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) speeds[i] = (v_[i] + fall).norm();
+  });
+  return parallelMax(speeds);
+}
+
 // The carried channels one after another.
 template <int Dim>
 std::vector<float> ParticleSolver<Dim>::carriedState() const {

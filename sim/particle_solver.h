@@ -149,6 +149,8 @@ class ParticleSolver : public FluidSolver<Dim> {
     return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, Boundary<Dim>{walls_, colliders_}, mass_, restDensity_,
                                         weight);
   }
+  // The fastest particle's speed after `dt` of gravity: the CFL conditions' |v|max.
+  float fastestAfterFall(float dt);
   // The first particle that is not finite, left the tank or ran away (firstParticleOutside), or -1.
   long firstBadParticle() const { return firstParticleOutside(x_, v_, walls_, speedLimit_); }
   // Bytes held by the shared channels, the grid, the lists and the colliders (capacities).

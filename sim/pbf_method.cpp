@@ -47,8 +47,8 @@ std::vector<std::string> pbfNotes(const Scene& scene) {
   const int stable = stableSubsteps(scene);
   if (stable <= scene.solver.substeps) return {};
   return {"solver.substeps " + std::to_string(scene.solver.substeps) + " is below the " + std::to_string(stable) +
-          " a PBF pool this deep needs to stay at rest (dt <= 0.9 particle_spacing / sqrt(g depth)); leave it out "
-          "to get them"};
+          " a PBF pool this deep needs to stay at rest (dt <= 0.9 particle_spacing / sqrt(g depth)): its steps "
+          "will be shortened to them while the fluid stands that deep"};
 }
 
 }  // namespace

@@ -41,10 +41,11 @@ class PbfSolver final : public ParticleSolver<Dim> {
   // `shapes`: the scene's collider shapes, built once by the caller; null builds them from the scene.
   explicit PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes = nullptr);
 
-  // The frame loop's interface (see sim/simulation.cpp): PBF takes the scene's substeps a frame.
+  // The frame loop's interface (see sim/simulation.cpp): PBF takes the scene's substeps a frame, each shortened
+  // when the state needs it (stableTimeStep).
   int fixedSubsteps() const override { return substeps_; }
   void beginFrame(double) override {}
-  float stableTimeStep() override { return INFINITY; }
+  float stableTimeStep() override;
 
   // One time step of Algorithm 1 from `time` (which moves the attractor). Returns the index of the first
   // particle whose state is not finite or lies outside the domain afterwards, or -1 if all are well.
@@ -99,6 +100,13 @@ class PbfSolver final : public ParticleSolver<Dim> {
   int iterations_;
   double maxDensityError_;
   int substeps_;
+  float cfl_, frameStep_, spacing_;  // the Courant number; a frame over the substeps; the particle spacing
+  // The deepest column (stableTimeStep): the particles counted on a grid over the tank's floor.
+  float deepestColumn();
+  int down_ = 1;                      // the axis gravity is mostly along
+  Vec<Dim> floorMin_, columnWidth_;   // the grid's corner and cell size (the down axis's unused)
+  Eigen::Matrix<int, Dim, 1> columns_;
+  std::vector<uint32_t> columnCounts_;
 
   // PBF's channels beside the core's: the predicted positions x* and the multipliers.
   std::vector<VecD> p_;

@@ -71,9 +71,6 @@ float walkWhileContiguous(const std::vector<float>& sorted, size_t start, float 
                  " m/s, ten times the fastest the scene can give it)");
 }
 
-// The frame loop, for any solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
-// otherwise each step is the largest stable one (stableTimeStep) shortened so the steps left end exactly on the
-// frame: dt = remaining / ceil(remaining / stable).
 // The particles run() starts from: the newest frame of a resumed run (with the method's carried state and the
 // bodies' states there), or the scene's fluid less what lies inside colliders and bodies. Returns the initial
 // lattice's count, where the emitters' ids begin.
@@ -106,9 +103,10 @@ uint32_t startParticles(const Scene& scene, const fs::path& dir, bool resume, Fl
   return scene.emitters.empty() ? 0 : static_cast<uint32_t>(initialParticles(scene).size());
 }
 
-// The frame loop, for any solver. A solver with fixedSubsteps() > 0 takes that many equal steps a frame;
-// otherwise each step is the largest stable one (stableTimeStep) shortened so the steps left end exactly on the
-// frame: dt = remaining / ceil(remaining / stable). Each frame's record goes to every FrameOutput.
+// The frame loop, for any solver. Each step is the largest stable one (stableTimeStep) shortened so the steps
+// left end exactly on the frame: dt = remaining / ceil(remaining / stable). A solver with fixedSubsteps() > 0
+// takes that many equal steps a frame while the stable step is no shorter, which is then its longest (a frame
+// whose steps all meet the need runs as it did before the need was checked). Each frame's record goes to every FrameOutput.
 template <int Dim>
 SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
                       bool resume, Progress& progress) {
@@ -170,14 +168,18 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     int iterations = 0, divergenceIterations = 0, steps = 0;
     float smallestStep = INFINITY;
     double remaining = frameDuration;
+    bool shortened = false;  // a step of this frame was shorter than the fixed substeps'
     while (remaining > 0) {
       float dt;
-      if (solver.fixedSubsteps() > 0) {
-        dt = static_cast<float>(frameDuration / solver.fixedSubsteps());
+      const float fixed = solver.fixedSubsteps() > 0 ? static_cast<float>(frameDuration / solver.fixedSubsteps()) : 0;
+      const double stable = solver.stableTimeStep();
+      if (fixed > 0 && !shortened && stable >= fixed) {
+        dt = fixed;
         remaining = steps + 1 == solver.fixedSubsteps() ? 0 : remaining - dt;
       } else {
-        const double stable = solver.stableTimeStep();
-        const double count = std::max(1.0, std::ceil(remaining / stable - 1e-9));
+        shortened = fixed > 0;
+        const double longest = fixed > 0 ? std::min<double>(stable, fixed) : stable;
+        const double count = std::max(1.0, std::ceil(remaining / longest - 1e-9));
         dt = static_cast<float>(remaining / count);
         remaining = count == 1 ? 0 : remaining - dt;
       }

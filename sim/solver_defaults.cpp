@@ -58,9 +58,13 @@ int stableSubsteps(const Scene& scene) {
               std::pow(scene.particle_spacing, d);
   const double depth = std::min(volume / floor, scene.domain.max[down] - scene.domain.min[down]);
   if (!(depth > 0)) return 1;
-  const double longest = 0.9 * scene.particle_spacing / std::sqrt(g * depth);
+  const double longest = depthStableStep(scene.particle_spacing, g, depth);
   const double steps = std::ceil(1.0 / (scene.output.fps * longest) - 1e-9);
   return int(std::min(steps, 100000.0));
+}
+
+double depthStableStep(double spacing, double g, double depth) {
+  return g > 0 && depth > 0 ? 0.9 * spacing / std::sqrt(g * depth) : INFINITY;
 }
 
 int emitterSubsteps(const Scene& scene) {

@@ -23,6 +23,9 @@ size_t mostParticles(const Scene& scene);
 // particle by g dt^2, and a column of H / spacing layers sags by g dt^2 H / spacing before the iterations push it
 // back; near a spacing the layers pass through each other and the pool boils (docs/speed-accuracy.md).
 int stableSubsteps(const Scene& scene);
+// That criterion's longest step for a column `depth` deep under gravity `g` (also PbfSolver::stableTimeStep's, on
+// the deepest column as the fluid stands).
+double depthStableStep(double spacing, double g, double depth);
 
 // The fewest steps a frame with which the fastest emitter's jet moves at most half a spacing a step: faster,
 // PBF's corrections push the layer just emitted back onto the next one's sites, which then stay empty (a 1 m/s

@@ -18,26 +18,10 @@
 #include "core/progress.h"
 #include "sim/simulation.h"
 #include "sim/solver_defaults.h"
+#include "tests/sim/stats_columns.h"
 
 namespace surge {
 namespace {
-
-// stats.csv as columns by name.
-std::map<std::string, std::vector<double>> readStats(const fs::path& dir) {
-  std::ifstream in(dir / "stats.csv");
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> names;
-  std::stringstream header(line);
-  for (std::string name; std::getline(header, name, ',');) names.push_back(name);
-  std::map<std::string, std::vector<double>> columns;
-  while (std::getline(in, line)) {
-    std::stringstream row(line);
-    std::string cell;
-    for (size_t k = 0; k < names.size() && std::getline(row, cell, ','); ++k) columns[names[k]].push_back(std::strtod(cell.c_str(), nullptr));
-  }
-  return columns;
-}
 
 fs::path runScene(const Scene& scene, const std::string& name, int threads = 2, bool resume = false) {
   const fs::path dir = fs::path(::testing::TempDir()) / name;
