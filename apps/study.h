@@ -3,6 +3,7 @@
 // stats.csv and frames, computes the accuracy figures, and writes study.csv and the gnuplot plots.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -85,5 +86,38 @@ std::string writeStudyPlots(const fs::path& dir, const std::vector<Sweep>& sweep
 
 // The runs on the Pareto front of (CPU seconds, error): none cheaper is at least as accurate. Sorted by CPU.
 std::vector<int> paretoFront(const std::vector<StudyRun>& runs);
+
+// printf of one number with `spec`; "" for NaN (an empty CSV field).
+std::string format(double value, const char* spec = "%.6g");
+// Writes `text` to `script` and runs gnuplot on it (its output into the script's name with .log). Returns "" or
+// a one-line warning when gnuplot is missing or failed.
+std::string runGnuplot(const fs::path& script, const std::string& text);
+
+// --measure (apps/study_convergence.cpp): a quantity read from each run at one time. `COLUMN@T` is a stats.csv
+// column, `bodies.NAME.COLUMN@T` a body's bodies.csv column, `colliders.NAME.COLUMN@T` a collider's
+// colliders.csv column, at T seconds (linear in time between frames).
+struct Measure {
+  std::string text;    // as given
+  std::string file;    // stats.csv, bodies.csv or colliders.csv
+  std::string name;    // the body or collider ("" for stats.csv)
+  std::string column;
+  double time = 0;
+};
+// InputError naming --measure for a form it does not know, a column its file lacks, a body or collider the
+// scene does not have, or a time outside the run.
+Measure parseMeasure(const std::string& text, const Scene& scene);
+// The measure in a run's folder; NaN when the run ended before its time.
+double readMeasure(const Measure& measure, const fs::path& folder, double fps);
+
+// Richardson extrapolation over a spacing sweep: f(h) = f0 + C h^p through the three finest runs, p the observed
+// order; each run's error estimate is |f - f0| (against the finest run when no order is found, as verdict says).
+struct Convergence {
+  std::vector<double> spacing, value, error;  // coarsest first
+  double order = NAN, extrapolated = NAN, coefficient = NAN;
+  std::string verdict;
+};
+Convergence richardson(std::vector<double> spacing, std::vector<double> value);
+// convergence.csv (one row a run) and convergence.png in dir; returns "" or gnuplot's warning.
+std::string writeConvergence(const fs::path& dir, const Measure& measure, const Convergence& result);
 
 }  // namespace surge

@@ -164,6 +164,7 @@ void addStudyCommand(CLI::App& app) {
     std::string scene;
     std::vector<std::string> sweeps;
     int frames = 0;
+    std::string measure;
     int runIndex = -1;
     bool report = false;
     SlurmOptions slurm;
@@ -177,6 +178,11 @@ void addStudyCommand(CLI::App& app) {
       ->required();
   command->add_option("--frames", options->frames, "output frames per run (default: the scene's output.frames)")
       ->check(CLI::PositiveNumber);
+  command->add_option("--measure", options->measure,
+                      "a convergence study over a particle_spacing sweep of three or more values: the observed order, "
+                      "the Richardson-extrapolated value and each run's error estimate of COLUMN@T (stats.csv), "
+                      "bodies.NAME.COLUMN@T or colliders.NAME.COLUMN@T (convergence.csv, convergence.png)")
+      ->type_name("WHAT@SECONDS");
   command->add_option("--run-index", options->runIndex,
                       "run only the sweep point of this index (0-based) into its runs/ folder, no report (a Slurm "
                       "array task of surge study --slurm)")
@@ -208,6 +214,20 @@ void addStudyCommand(CLI::App& app) {
     if (options->frames > 0) base.push_back("output.frames=" + std::to_string(options->frames));
     const Scene scene = loadScene(options->scene, base);
     const fs::path dir = outputFolder(common, scene).string() + (common.out.empty() ? "_study" : "");
+    Measure measure;
+    if (!options->measure.empty()) {
+      measure = parseMeasure(options->measure, scene);
+      if (sweeps.size() != 1 || sweeps[0].key != "particle_spacing")
+        throw InputError("--measure", options->measure, "measures convergence over one sweep, of particle_spacing");
+      if (sweeps[0].values.size() < 3)
+        throw InputError("--sweep", "particle_spacing", "a convergence study needs three spacings or more, not " +
+                                                            std::to_string(sweeps[0].values.size()));
+      std::vector<double> spacings;
+      for (const std::string& value : sweeps[0].values) spacings.push_back(std::atof(value.c_str()));
+      std::sort(spacings.begin(), spacings.end());
+      if (std::adjacent_find(spacings.begin(), spacings.end()) != spacings.end())
+        throw InputError("--sweep", "particle_spacing", "a convergence study needs distinct spacings");
+    }
     std::vector<StudyRun> runs;
     std::vector<std::vector<std::string>> overrides;
     for (const std::vector<std::string>& values : combinations(sweeps)) {
@@ -231,6 +251,7 @@ void addStudyCommand(CLI::App& app) {
       std::vector<std::string> arguments = {fs::absolute(options->scene).string(), "--out", absolute.string()};
       for (const std::string& sweep : options->sweeps) arguments.insert(arguments.end(), {"--sweep", sweep});
       if (options->frames > 0) arguments.insert(arguments.end(), {"--frames", std::to_string(options->frames)});
+      if (!options->measure.empty()) arguments.insert(arguments.end(), {"--measure", options->measure});
       for (const std::string& assignment : common.overrides) arguments.insert(arguments.end(), {"--set", assignment});
       arguments.push_back("--quiet");
       if (!options->slurm.dryRun) {
@@ -282,8 +303,21 @@ void addStudyCommand(CLI::App& app) {
       errorLabel = damBreak ? "RMS error of front and back height (m)" : "density field error (fraction)";
     }
     writeStudyCsv(dir / "study.csv", sweeps, runs);
-    const std::string warning = writeStudyPlots(dir, sweeps, runs, reference, errorLabel);
+    std::string warning = writeStudyPlots(dir, sweeps, runs, reference, errorLabel);
     if (!warning.empty()) std::fprintf(stderr, "surge: warning: %s\n", warning.c_str());
+    if (!options->measure.empty()) {
+      std::vector<double> spacings, values;
+      for (const StudyRun& run : runs) {
+        spacings.push_back(std::atof(run.values[0].c_str()));
+        values.push_back(readMeasure(measure, run.folder, scene.output.fps));
+      }
+      const Convergence result = richardson(spacings, values);
+      warning = writeConvergence(dir, measure, result);
+      if (!warning.empty()) std::fprintf(stderr, "surge: warning: %s\n", warning.c_str());
+      say(common, "study: " + measure.text + ": " + result.verdict +
+                      (std::isfinite(result.extrapolated) ? ", extrapolated " + format(result.extrapolated) : "") +
+                      " -> " + (dir / "convergence.csv").string());
+    }
 
     int bad = 0;
     for (const StudyRun& run : runs) bad += run.status != "ok";

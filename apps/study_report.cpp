@@ -77,13 +77,6 @@ std::string csvField(const std::string& text) {
   return quoted + "\"";
 }
 
-std::string format(double value, const char* spec = "%.6g") {
-  if (std::isnan(value)) return "";
-  char text[64];
-  std::snprintf(text, sizeof text, spec, value);
-  return text;
-}
-
 // True if an executable `name` is on PATH.
 bool onPath(const std::string& name) {
   const char* path = std::getenv("PATH");
@@ -107,6 +100,13 @@ std::string label(const StudyRun& run) {
 }
 
 }  // namespace
+
+std::string format(double value, const char* spec) {
+  if (std::isnan(value)) return "";
+  char text[64];
+  std::snprintf(text, sizeof text, spec, value);
+  return text;
+}
 
 void writeRunRecord(const StudyRun& run) {
   const nlohmann::json record = {{"status", run.status},           {"message", run.message},
@@ -325,10 +325,13 @@ std::string writeStudyPlots(const fs::path& dir, const std::vector<Sweep>& sweep
     }
     gp << "unset multiplot\n";
   }
-  const fs::path script = dir / "plots.gp";
-  writeFileAtomically(script, [&](std::ostream& out) { out << gp.str(); });
+  return runGnuplot(dir / "plots.gp", gp.str());
+}
 
-  const std::string scriptText = script.string(), log = (dir / "plots.log").string();
+std::string runGnuplot(const fs::path& script, const std::string& text) {
+  if (!onPath("gnuplot")) return "gnuplot is not installed: no plots (the tables are complete)";
+  writeFileAtomically(script, [&](std::ostream& out) { out << text; });
+  const std::string scriptText = script.string(), log = fs::path(script).replace_extension(".log").string();
   std::vector<std::string> args = {"gnuplot", scriptText};
   std::vector<char*> argv = {args[0].data(), args[1].data(), nullptr};
   posix_spawn_file_actions_t files;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Surge set-up: installs the Debian 12 packages that are missing, configures and builds, then
 #   scripts/setup.sh demo   runs scenes/dam_break.json to out/dam_break/dam_break.mp4
-#   scripts/setup.sh test   runs the whole test suite (ctest)
+#   scripts/setup.sh test   runs the whole test suite (ctest), less the shipped scenes run to their ends
+#   scripts/setup.sh scenes runs every shipped scene to its last frame (ctest -L scenes, about ten minutes)
 #   scripts/setup.sh build  only builds
 #   scripts/setup.sh sanitize  builds everything with ASan and UBSan in build-sanitize and runs the test suite
 # Idempotent: a second run installs nothing and rebuilds only what changed. Works as root or through sudo.
@@ -44,7 +45,7 @@ if [ "$action" = sanitize ]; then
   cmake -S . -B "$build_dir-sanitize" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSURGE_SANITIZE=ON \
     -DSURGE_BUILD_BENCHMARKS=OFF -DSURGE_ARCH="${SURGE_ARCH:-}" -Wno-dev >/dev/null
   cmake --build "$build_dir-sanitize" -j "$jobs"
-  exec ctest --test-dir "$build_dir-sanitize" --output-on-failure -j "$jobs" --timeout 2700
+  exec ctest --test-dir "$build_dir-sanitize" --output-on-failure -j "$jobs" --timeout 2700 -LE scenes
 fi
 # SURGE_ARCH=x86-64-v3 (say) builds for every node of a cluster from that CPU up instead of for this machine's
 # CPU (docs/cluster.md); empty keeps -march=native.
@@ -60,7 +61,7 @@ case "$action" in
     echo "surge setup: video at out/dam_break/dam_break.mp4"
     ;;
   test)
-    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" --timeout 900
+    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" --timeout 900 -LE scenes
     # The fuzz regression (docs/reliability.md): the readers built again with clang, ASan, UBSan and libFuzzer
     # in a folder of their own, and every committed corpus input run once.
     CC=clang CXX=clang++ cmake -S . -B "$build_dir-fuzz" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSURGE_FUZZ=ON \
@@ -68,5 +69,9 @@ case "$action" in
     cmake --build "$build_dir-fuzz" -j "$jobs" --target surge_fuzzers
     ctest --test-dir "$build_dir-fuzz" -L fuzz --output-on-failure -j "$jobs"
     ;;
-  *) echo "usage: scripts/setup.sh [build|demo|test|sanitize]" >&2; exit 2 ;;
+  scenes)
+    # Every shipped scene to its last frame (tests/scenes/scenes_test.sh): about ten minutes on two cores.
+    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -L scenes
+    ;;
+  *) echo "usage: scripts/setup.sh [build|demo|test|scenes|sanitize]" >&2; exit 2 ;;
 esac

@@ -88,6 +88,7 @@ const StatsColumn kStatsColumns[] = {
     {"back_height", [](const FrameRecord& r) { return printed("%.6g", r.dam.backHeight); }},
     {"emitted", [](const FrameRecord& r) { return std::to_string(r.emitted); }},
     {"removed", [](const FrameRecord& r) { return std::to_string(r.removed); }},
+    {"potential_energy", [](const FrameRecord& r) { return printed("%.6g", r.potentialEnergy); }},
 };
 
 class StatsOutput final : public FrameOutput {

@@ -35,6 +35,7 @@ struct FrameRecord {
   double divergenceIterations = NAN;  // a step, on average; NaN for a method without a divergence solver
   double smallestStep = 0, wallSeconds = 0;
   double pressureMax = NAN;      // NaN for a method without pressures
+  double potentialEnergy = 0;    // the fluid's, against the tank's floor (potentialEnergy, sim/simulation.h)
   size_t emitted = 0, removed = 0;  // particles the emitters added, and the sinks and open faces removed
   PhaseTimes phases;
   std::vector<Wrench> colliderWrenches, bodyWrenches;  // the frame's mean; empty at frame 0

@@ -140,6 +140,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
   record.particles = &frame;
   auto writeFrame = [&] {
     record.dam = measureDamBreak(scene, frame);
+    record.potentialEnergy = potentialEnergy(scene, frame, solver.particleMass());
     record.carriedState = solver.carriedState();
     for (const std::unique_ptr<FrameOutput>& output : outputs) output->write(record);
   };
@@ -285,6 +286,16 @@ void checkSimulationStart(const Scene& scene, std::shared_ptr<const ColliderShap
   if (!shaped && !scene.hasSources()) return;
   if (scene.dimensions == 2) checkStart<2>(scene, std::move(shapes));
   else checkStart<3>(scene, std::move(shapes));
+}
+
+double potentialEnergy(const Scene& scene, const ParticleFrame& frame, double particleMass) {
+  const int d = scene.dimensions;
+  Eigen::Vector3d g = Eigen::Vector3d::Zero(), corner = Eigen::Vector3d::Zero();
+  g.head(d) = scene.gravity.head(d);
+  for (int k = 0; k < d; ++k) corner[k] = g[k] < 0 ? scene.domain.min[k] : scene.domain.max[k];
+  double sum = 0;
+  for (const Eigen::Vector3f& x : frame.position) sum += g.dot(corner - x.cast<double>());
+  return particleMass * sum;
 }
 
 DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame) {

@@ -54,6 +54,11 @@ SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderSha
 //               spacing, measured from domain.min.y.
 DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame);
 
+// The fluid's potential energy against the tank's floor, sum over particles of m g . (c - x), c the tank's
+// corner lowest along gravity: 0 for fluid on the floor's plane, growing with height (J; J/m in 2D, as the
+// kinetic energy). Summed in the frame's order, the same at any thread count.
+double potentialEnergy(const Scene& scene, const ParticleFrame& frame, double particleMass);
+
 // True for a scene whose fluid is one box on the floor against one x wall (and not the other): a dam break,
 // whose front_x and back_height can be compared with experiments (Martin & Moyce 1952) and across runs.
 bool isDamBreak(const Scene& scene);

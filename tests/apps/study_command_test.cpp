@@ -2,6 +2,7 @@
 // written; and the dam-break columns of stats.csv.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -155,6 +156,114 @@ TEST(StudyCommand, StatsCarryFrontAndBackHeightOfTheDamBreak) {
     EXPECT_NEAR(std::stod(rows[1][height]), 0.4, 1e-6) << side;
     EXPECT_GT(std::stod(rows[11][front]), 0.6) << side;   // 1/3 s: the front has run about 2 column heights
     EXPECT_LT(std::stod(rows[11][height]), 0.35) << side;
+  }
+}
+
+// The tiny dam break with a cork floating beyond the column, for a body's measure.
+std::string tinyDamBreakWithCork() {
+  std::string text = kTinyDamBreak;
+  text.insert(text.find("\"output\""), R"("bodies": [{"name": "cork", "shape": "box", "size": [0.1, 0.06], "position": [0.8, 0.1],
+    "density": 300}],
+  )");
+  return text;
+}
+
+// surge study --measure (issue 32): the observed order and the Richardson-extrapolated value of a quantity over a
+// particle_spacing sweep, checked on runs whose answer is known exactly, on a real sweep, and on bad input.
+// Runs already on disk whose front_x at 0.1 s is 2 + 3 h^2 exactly, at spacings in unequal ratios (0.04, 0.03,
+// 0.02): `--report` reads them, and the observed order is 2 and the extrapolated value 2 to the printed digits,
+// each run's error estimate 3 h^2. Half-way between two frames (0.05 s) the value is the frames' mean.
+TEST(StudyConvergence, OrderAndExtrapolationOfAnExactlyKnownQuantity) {
+  const fs::path scene = writeTestScene("tiny_convergence.json", tinyDamBreakWithCork());
+  const fs::path out = fs::path(testing::TempDir()) / "surge_convergence_exact";
+  fs::remove_all(out);
+  const double spacings[] = {0.04, 0.03, 0.02};
+  for (int k = 0; k < 3; ++k) {
+    char name[64];
+    std::snprintf(name, sizeof name, "%03d_particle_spacing=%g", k, spacings[k]);
+    const fs::path run = out / "runs" / name;
+    fs::create_directories(run);
+    std::ofstream stats(run / "stats.csv");
+    stats << "frame,time,particles,substeps,iterations,front_x,back_height\n";
+    for (int frame = 0; frame <= 4; ++frame) {
+      const double h = spacings[k], value = frame == 3 ? 2 + 3 * h * h : (frame == 1 ? 1.0 : 1.5);
+      stats << frame << "," << frame / 30.0 << ",400,4,4," << value << ",0.3\n";
+    }
+    std::ofstream(run / "run.json") << R"({"status": "ok", "cpu_seconds": 1, "wall_seconds": 1})";
+    // The last frame the report compares the runs' density fields at: one particle, the same in each.
+    fs::create_directories(run / "particles");
+    std::ofstream(run / "particles" / "frame_00004.ply")
+        << "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+        << "property float vx\nproperty float vy\nproperty float vz\nproperty uint id\nend_header\n"
+        << "0.1 0.1 0 0 0 0 0\n";
+  }
+  const SurgeResult r = runSurge("study '" + scene.string() + "' --quiet --report --sweep particle_spacing=0.04,0.03,0.02" +
+                                 " --measure front_x@0.1 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = readCsv(out / "convergence.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[0][0] + rows[0][1] + rows[0][2] + rows[0][3] + rows[0][4],
+            "particle_spacingmeasurederror_estimateobserved_orderextrapolated");
+  for (size_t i = 1; i < rows.size(); ++i) {
+    const double h = spacings[i - 1];
+    EXPECT_DOUBLE_EQ(std::stod(rows[i][0]), h);
+    EXPECT_NEAR(std::stod(rows[i][2]), 3 * h * h, 1e-8);
+    EXPECT_NEAR(std::stod(rows[i][3]), 2.0, 1e-5);
+    EXPECT_NEAR(std::stod(rows[i][4]), 2.0, 1e-8);
+  }
+  EXPECT_TRUE(fs::exists(out / "convergence.png"));
+  // Between frames: the mean of frames 1 and 2, the same in every run, converged.
+  const SurgeResult between = runSurge("study '" + scene.string() + "' --report --sweep particle_spacing=0.04,0.03,0.02" +
+                                       " --measure front_x@0.05 --out " + out.string());
+  ASSERT_EQ(between.status, 0) << between.err;
+  EXPECT_NE(between.out.find("the two finest runs agree exactly"), std::string::npos) << between.out;
+  EXPECT_DOUBLE_EQ(std::stod(readCsv(out / "convergence.csv")[1][1]), 1.25);
+}
+
+// A real sweep: three spacings of the tiny dam break, the cork's height from bodies.csv at 0.3 s. Every run
+// reaches it, and the table has one row a spacing, coarsest first, with the measured values.
+TEST(StudyConvergence, ASpacingSweepMeasuresABodyColumn) {
+  const fs::path scene = writeTestScene("tiny_convergence.json", tinyDamBreakWithCork());
+  const fs::path out = fs::path(testing::TempDir()) / "surge_convergence_sweep";
+  fs::remove_all(out);
+  const SurgeResult r = runSurge("study '" + scene.string() + "' --sweep particle_spacing=0.02,0.04,0.03" +
+                                 " --measure bodies.cork.y@0.3 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("bodies.cork.y@0.3"), std::string::npos) << r.out;
+  const auto rows = readCsv(out / "convergence.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[1][0] + "/" + rows[2][0] + "/" + rows[3][0], "0.04/0.03/0.02");
+  for (size_t i = 1; i < rows.size(); ++i) {
+    const double y = std::stod(rows[i][1]);
+    EXPECT_GT(y, 0.0);  // the cork is in the tank, floating or carried
+    EXPECT_LT(y, 0.6);
+    EXPECT_GE(std::stod(rows[i][2]), 0.0);
+  }
+}
+
+// One line naming the key, exit 2, nothing written: a column no file has, a body the scene lacks, a time past the
+// run, two spacings, another key swept.
+TEST(StudyConvergence, BadMeasuresAreRefusedBeforeAnythingIsWritten) {
+  const fs::path scene = writeTestScene("tiny_convergence.json", tinyDamBreakWithCork());
+  const fs::path out = fs::path(testing::TempDir()) / "surge_convergence_bad";
+  fs::remove_all(out);
+  const std::string spacings = " --sweep particle_spacing=0.04,0.03,0.02";
+  const std::pair<std::string, std::string> cases[] = {
+      {spacings + " --measure no_such_column@0.1", "--measure"},
+      {spacings + " --measure bodies.ghost.y@0.1", "--measure"},
+      {spacings + " --measure colliders.cork.fx@0.1", "--measure"},
+      {spacings + " --measure bodies.cork.no_such@0.1", "--measure"},
+      {spacings + " --measure front_x@5", "--measure"},
+      {spacings + " --measure front_x", "--measure"},
+      {" --sweep particle_spacing=0.04,0.02 --measure front_x@0.1", "--sweep"},
+      {" --sweep solver.iterations=1,2,4 --measure front_x@0.1", "--measure"},
+  };
+  for (const auto& [arguments, key] : cases) {
+    const SurgeResult r = runSurge("study '" + scene.string() + "' --quiet" + arguments + " --out " + out.string());
+    EXPECT_EQ(r.status, 2) << arguments << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(key), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << arguments;
   }
 }
 
