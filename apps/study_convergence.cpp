@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 
 #include "apps/study.h"
 #include "core/errors.h"
@@ -16,13 +15,6 @@
 namespace surge {
 namespace {
 
-std::vector<std::string> fieldsOf(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream in(line);
-  for (std::string field; std::getline(in, field, ',');) fields.push_back(field);
-  return fields;
-}
-
 int columnOf(const std::vector<std::string>& header, const std::string& name) {
   const auto at = std::find(header.begin(), header.end(), name);
   return at == header.end() ? -1 : int(at - header.begin());
@@ -31,7 +23,7 @@ int columnOf(const std::vector<std::string>& header, const std::string& name) {
 // The columns a measure may name in each file: every column but those that say which row it is.
 std::vector<std::string> measurableColumns(const char* header) {
   std::vector<std::string> columns;
-  for (const std::string& name : fieldsOf(header))
+  for (const std::string& name : splitCsvLine(header))
     if (name != "frame" && name != "time" && name != "body" && name != "collider") columns.push_back(name);
   return columns;
 }
@@ -89,12 +81,12 @@ double readMeasure(const Measure& measure, const fs::path& folder, double fps) {
   std::ifstream in(folder / measure.file);
   std::string line;
   if (!std::getline(in, line)) return NAN;
-  const std::vector<std::string> header = fieldsOf(line);
+  const std::vector<std::string> header = splitCsvLine(line);
   const int value = columnOf(header, measure.column), frame = columnOf(header, "frame");
   const int name = columnOf(header, measure.file == "bodies.csv" ? "body" : "collider");
   double beforeTime = NAN, beforeValue = NAN;
   while (std::getline(in, line)) {
-    const std::vector<std::string> f = fieldsOf(line);
+    const std::vector<std::string> f = splitCsvLine(line);
     if (int(f.size()) <= std::max(value, frame)) continue;
     if (!measure.name.empty() && (name < 0 || int(f.size()) <= name || f[size_t(name)] != measure.name)) continue;
     const double t = std::atof(f[size_t(frame)].c_str()) / fps, v = std::atof(f[size_t(value)].c_str());

@@ -26,14 +26,6 @@ extern char** environ;
 namespace surge {
 namespace {
 
-std::vector<std::string> splitCsvLine(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream in(line);
-  std::string field;
-  while (std::getline(in, field, ',')) fields.push_back(field);
-  if (!line.empty() && line.back() == ',') fields.push_back("");
-  return fields;
-}
 
 double number(const std::vector<std::string>& fields, int column) {
   if (column < 0 || column >= int(fields.size()) || fields[column].empty()) return NAN;
@@ -100,6 +92,15 @@ std::string label(const StudyRun& run) {
 }
 
 }  // namespace
+
+std::vector<std::string> splitCsvLine(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream in(line);
+  std::string field;
+  while (std::getline(in, field, ',')) fields.push_back(field);
+  if (!line.empty() && line.back() == ',') fields.push_back("");
+  return fields;
+}
 
 std::string format(double value, const char* spec) {
   if (std::isnan(value)) return "";

@@ -83,6 +83,7 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
     if (k == down_) continue;
     columns_[k] = std::max(1, int(std::lround(columnWidth_[k] / (kColumnSpacings * spacing))));
     columnWidth_[k] /= float(columns_[k]);
+    columnArea_ *= columnWidth_[k];
   }
 }
 
@@ -113,11 +114,8 @@ float PbfSolver<Dim>::deepestColumn() {
     }
     ++columnCounts_[cell];
   }
-  float area = 1;
-  for (int k = 0; k < Dim; ++k)
-    if (k != down_) area *= columnWidth_[k];
   const uint32_t most = *std::max_element(columnCounts_.begin(), columnCounts_.end());
-  return float(most) * std::pow(spacing_, float(Dim)) / area;
+  return float(most) * std::pow(spacing_, float(Dim)) / columnArea_;
 }
 
 template <int Dim>

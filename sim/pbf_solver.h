@@ -105,6 +105,7 @@ class PbfSolver final : public ParticleSolver<Dim> {
   float deepestColumn();
   int down_ = 1;                      // the axis gravity is mostly along
   Vec<Dim> floorMin_, columnWidth_;   // the grid's corner and cell size (the down axis's unused)
+  float columnArea_ = 1;              // a cell's area across the down axis (its length in 2D)
   Eigen::Matrix<int, Dim, 1> columns_;
   std::vector<uint32_t> columnCounts_;
 

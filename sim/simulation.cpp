@@ -106,7 +106,8 @@ uint32_t startParticles(const Scene& scene, const fs::path& dir, bool resume, Fl
 // The frame loop, for any solver. Each step is the largest stable one (stableTimeStep) shortened so the steps
 // left end exactly on the frame: dt = remaining / ceil(remaining / stable). A solver with fixedSubsteps() > 0
 // takes that many equal steps a frame while the stable step is no shorter, which is then its longest (a frame
-// whose steps all meet the need runs as it did before the need was checked). Each frame's record goes to every FrameOutput.
+// whose steps all meet the need runs as before the need was checked). Each frame's record goes to every
+// FrameOutput.
 template <int Dim>
 SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
                       bool resume, Progress& progress) {

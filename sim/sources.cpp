@@ -151,9 +151,8 @@ template <int Dim>
 FluidSources<Dim>::FluidSources(const Scene& scene, uint32_t firstId, double time)
     : scene_(scene),
       spacing_(static_cast<float>(scene.particle_spacing)),
-      domainMin_(scene.domain.min.template head<Dim>().template cast<float>()),
-      domainMax_(scene.domain.max.template head<Dim>().template cast<float>()),
-      gravity_(scene.gravity),
+      domainMin_(toVec<Dim>(scene.domain.min)),
+      domainMax_(toVec<Dim>(scene.domain.max)),
       nextId_(firstId) {
   for (int axis = 0; axis < Dim; ++axis)
     for (int upper = 0; upper < 2; ++upper)
@@ -221,6 +220,21 @@ void FluidSources<Dim>::checkStart(const std::vector<VecD>& particles, const Col
     throw InputError(scene_.source, "sinks", "hold the whole initial fluid: nothing would be left to simulate");
 }
 
+// How far to move water found in a nozzle (at `r` from the face's centre, `along` its direction d and `across`
+// it) toward the nearest way out: behind the face, past the sides or ahead of the held layers, at most
+// kIntruderStep spacings a step, so that water standing where a nozzle opens (a submerged emitter's start)
+// clears over a few steps without piling onto what is around it.
+template <int Dim>
+Vec<Dim> FluidSources<Dim>::outOfNozzle(const VecD& r, float along, float across, const VecD& d, float reach,
+                                        float depth) const {
+  const float radius = 0.5f * spacing_, most = kIntruderStep * spacing_;
+  const float back = along + radius, side = reach + radius - across, ahead = depth + radius - along;
+  if (back <= side && back <= ahead) return -std::min(back, most) * d;
+  if (ahead <= side) return std::min(ahead, most) * d;
+  const VecD outward = across > 0 ? VecD((r - along * d) / across) : VecD(VecD::Unit(Dim - 1));
+  return std::min(side, most) * outward;
+}
+
 // Emitter e's part of the edit after the step that ended at `time`: its nozzle held, and the layers it owes.
 template <int Dim>
 void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
@@ -237,10 +251,11 @@ void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
   const double pushed = emitter.pushed(time), pitch = emitter.pitch();
   // Where site j of the layer `offset` in front of the face is, and how fast it moves: in free flight since it
   // left the face, so that holding a jet into air in its nozzle changes nothing.
+  const Eigen::Vector3d& g = scene_.gravity;
   auto nozzleSite = [&](double offset, size_t j, VecD& velocity) {
     const double flight = speed > 0 ? std::max(0.0, offset) / speed : 0.0;
-    velocity = toVec<Dim>(jet + flight * gravity_);
-    return toVec<Dim>(emitter.site(j, centre + offset * direction, direction) + 0.5 * flight * flight * gravity_);
+    velocity = toVec<Dim>(jet + flight * g);
+    return toVec<Dim>(emitter.site(j, centre + offset * direction, direction) + 0.5 * flight * flight * g);
   };
 
   // The nozzle, kNozzleLayers layers in front of the face, is a pipe while the emitter runs: each particle of a
@@ -251,7 +266,15 @@ void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
   const size_t sites = emitter.sitesPerLayer();
   const size_t heldFrom =
       std::min(layers_[e], static_cast<size_t>(std::max(0.0, std::ceil((pushed - kNozzleLayers * pitch) / pitch))));
-  held_.assign((layers_[e] - heldFrom) * sites, 0);
+  // The held layers' sites, where their particles go and how fast, once for the scan below.
+  heldAt_.resize((layers_[e] - heldFrom) * sites);
+  heldVelocity_.resize(heldAt_.size());
+  for (size_t k = heldFrom; k < layers_[e]; ++k)
+    for (size_t j = 0; j < sites; ++j) {
+      const size_t slot = (k - heldFrom) * sites + j;
+      heldAt_[slot] = nozzleSite(pushed - double(k) * pitch, j, heldVelocity_[slot]);
+    }
+  held_.assign(heldAt_.size(), 0);
   const float farthest = std::max(static_cast<float>(pushed - double(layers_[e]) * pitch), depth) + s;
   nearby_.clear();
   for (size_t i = 0; i < x.size(); ++i) {
@@ -263,37 +286,24 @@ void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
     VecD at = x[i];
     if (speed > 0 && along > -radius && along < depth + radius && across < reach + radius) {
       const long k = std::lround((pushed - double(along)) / pitch);
-      bool held = k < long(heldFrom);  // a layer that has left the nozzle goes its own way
+      // A layer that has left the nozzle goes its own way; one in it rides its nearest site, if near and free.
+      long slot = -1;
       if (k >= long(heldFrom) && k < long(layers_[e])) {
-        const double offset = pushed - double(k) * pitch;
-        size_t nearest = 0;
+        const size_t first = (size_t(k) - heldFrom) * sites;
+        size_t nearest = first;
         float best = INFINITY;
-        VecD velocity;
-        for (size_t j = 0; j < sites; ++j) {
-          const float d2 = (nozzleSite(offset, j, velocity) - x[i]).squaredNorm();
+        for (size_t j = first; j < first + sites; ++j) {
+          const float d2 = (heldAt_[j] - x[i]).squaredNorm();
           if (d2 < best) best = d2, nearest = j;
         }
-        uint8_t& taken = held_[(size_t(k) - heldFrom) * sites + nearest];
-        if (best < radius * radius && !taken) {
-          taken = 1;
-          held = true;
-          at = nozzleSite(offset, nearest, velocity);
-          edit_.steer.push_back(static_cast<uint32_t>(i));
-          edit_.steerPosition.push_back(at);
-          edit_.steerVelocity.push_back(velocity);
-        }
+        if (best < radius * radius && !held_[nearest]) slot = long(nearest);
       }
-      if (!held) {
-        // At most kIntruderStep spacings a step: water standing where a nozzle opens (a submerged emitter's
-        // start) clears over a few steps without piling onto what is around it.
-        const float most = kIntruderStep * s;
-        const float back = along + radius, side = reach + radius - across, ahead = depth + radius - along;
-        if (back <= side && back <= ahead) at -= std::min(back, most) * d;
-        else if (ahead <= side) at += std::min(ahead, most) * d;
-        else at += std::min(side, most) * (across > 0 ? VecD((r - along * d) / across) : VecD(VecD::Unit(Dim - 1)));
+      if (slot >= 0 || k >= long(heldFrom)) {  // held, or water to move out
+        if (slot >= 0) held_[size_t(slot)] = 1;
+        at = slot >= 0 ? heldAt_[size_t(slot)] : VecD(at + outOfNozzle(r, along, across, d, reach, depth));
         edit_.steer.push_back(static_cast<uint32_t>(i));
         edit_.steerPosition.push_back(at);
-        edit_.steerVelocity.push_back(solver.velocities()[i]);
+        edit_.steerVelocity.push_back(slot >= 0 ? heldVelocity_[size_t(slot)] : solver.velocities()[i]);
       }
     }
     nearby_.push_back(at);

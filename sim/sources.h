@@ -74,6 +74,7 @@ class FluidSources {
 
  private:
   void emit(size_t e, FluidSolver<Dim>& solver, double time);
+  VecD outOfNozzle(const VecD& r, float along, float across, const VecD& d, float reach, float depth) const;
   bool inSink(const VecD& p) const;
   void placeSinks(double time);  // the moving sinks' poses and bounds at `time`
   bool pastOpenFace(const VecD& p) const;
@@ -82,7 +83,6 @@ class FluidSources {
   const Scene& scene_;
   float spacing_;
   VecD domainMin_, domainMax_;
-  Eigen::Vector3d gravity_;
   int openFaces_ = 0;  // bits: axis k's lower face 1 << 2k, upper 1 << (2k + 1)
   std::vector<EmitterSchedule> emitters_;
   std::vector<size_t> layers_;  // layers each emitter has made
@@ -90,7 +90,8 @@ class FluidSources {
   std::vector<std::unique_ptr<Sink>> sinks_;
   ParticleEdit<Dim> edit_;  // reused: no allocation once its capacity suffices
   std::vector<VecD> nearby_;    // where the particles near an emitter's face are after the edit
-  std::vector<uint8_t> held_;   // the nozzle's sites, by layer: 1 once a particle rides it
+  std::vector<VecD> heldAt_, heldVelocity_;  // the nozzle's sites, by layer, and their velocities
+  std::vector<uint8_t> held_;                // 1 once a particle rides the site
 };
 
 // The most particles the scene's emitters can make by `time` (every site filled): the memory check's count.

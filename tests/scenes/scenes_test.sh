@@ -15,13 +15,13 @@ failed=0
 for name in "${names[@]}"; do
   out="$work/$name"
   rm -rf "$out"
-  start=$(date +%s.%N)
+  start=$(date +%s%N)
   if ! "$surge" sim "$source/scenes/$name.json" --quiet --out "$out" 2>"$work/$name.err"; then
     echo "FAIL $name: $(tail -1 "$work/$name.err")"
     failed=1
     continue
   fi
-  seconds=$(echo "$(date +%s.%N) - $start" | bc)
+  seconds=$(( ($(date +%s%N) - start) / 1000000 ))e-3
   if verdict=$(python3 "$source/tests/scenes/check_scene_end.py" "$source/scenes/$name.json" "$out"); then
     printf 'ok   %-20s %6.1f s  %s\n' "$name" "$seconds" "$verdict"
   else
