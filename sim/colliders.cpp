@@ -396,6 +396,7 @@ std::vector<Wrench> Colliders<Dim>::takeSlotSums() {
   for (size_t s = 0; s < slots_.size(); ++s) {
     total[s % n].force += slots_[s].force;
     total[s % n].torque += slots_[s].torque;
+    total[s % n].work += slots_[s].work;
     slots_[s] = Wrench{};
   }
   return total;
@@ -406,6 +407,7 @@ void Colliders<Dim>::addWrenches(const std::vector<Wrench>& wrenches, double sca
   for (size_t c = 0; c < extra_.size(); ++c) {
     extra_[c].force += scale * wrenches[c].force;
     extra_[c].torque += scale * wrenches[c].torque;
+    extra_[c].work += scale * wrenches[c].work;
   }
 }
 

@@ -37,6 +37,9 @@ namespace surge {
 
 struct Wrench {
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
+  // The work the solid did on the fluid (J): each impulse it gave a particle dotted with its own velocity there
+  // (summed as the impulses are; 0 for a solid standing still). The energy ledger's share of a moving solid.
+  double work = 0;
 };
 
 // The shapes of the scene's colliders, then of its bodies, in the scene's order.
@@ -216,7 +219,7 @@ class Colliders {
   // Force bookkeeping. resetSlots once the particle count is known; addImpulse(i, c, J, x) records that
   // collider c gave particle i (at x) the impulse J, from inside a parallel loop whose chunks are multiples of
   // kChunk; takeFrameWrenches returns each collider's mean force and torque (about its position) over the
-  // frame's `duration` and starts the next frame.
+  // frame's `duration`, and the work it did on the fluid in it, and starts the next frame.
   void resetSlots(size_t particles);
   // For a new particle count between steps (emitters, sinks): the impulses recorded so far move to the frame's
   // sums, so the frame's wrench keeps them.
@@ -231,6 +234,7 @@ class Colliders {
     r.head<Dim>() = (at - placed_[c].centre).template cast<double>();
     w.force -= j;  // the fluid pushes the collider back
     w.torque -= r.cross(j);
+    if (placed_[c].moving) w.work += double(impulse.dot(wallVelocity(c, at)));
   }
   std::vector<Wrench> takeFrameWrenches(double duration);
   // Every solid's mean force and torque over the step of length dt just taken (the bodies' coupling); the

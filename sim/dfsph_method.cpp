@@ -35,6 +35,7 @@ void dfsphDefaults(Scene& scene) {
 // factor, and five more floats and a vector a particle (679 bytes measured at 3.3 million particles).
 const FluidMethod kDfsphMethod = {"dfsph", "Divergence-Free SPH (Bender & Koschier 2015, 2017)",
     &makeMethod<DfsphSolver, 2>, &makeMethod<DfsphSolver, 3>, 360, 800,
-    &dfsphPushesPerFrame, &dfsphDefaults, nullptr, &declareDfsphKeys};
+    &dfsphPushesPerFrame, &dfsphDefaults, nullptr, &declareDfsphKeys,
+    "more solver.substeps or a smaller solver.max_density_error"};
 
 }  // namespace surge

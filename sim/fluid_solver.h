@@ -110,6 +110,12 @@ struct FluidMethod {
   // Declares the method's own keys under `solver` (their defaults, ranges and docs text) to the scene reader,
   // writer and key table; null for none. Their values live in SolverSettings (core/scene.h).
   void (*declareKeys)(SceneVisitor&, SolverSettings&);
+  // The settings that make its steps more careful, for the energy stop's remedy (sim/energy_ledger.h): "more
+  // solver.substeps or solver.iterations"; null says shorter steps.
+  const char* steadier = nullptr;
+  // False for a method whose emitters make energy the account cannot see, so that the energy stop leaves its runs
+  // with emitters alone (WCSPH: a nozzle opening under water throws the pool about, docs/speed-accuracy.md).
+  bool emittersAccounted = true;
 };
 
 // FluidMethod::make2 and make3 for a solver class template.

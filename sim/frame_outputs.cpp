@@ -89,6 +89,7 @@ const StatsColumn kStatsColumns[] = {
     {"emitted", [](const FrameRecord& r) { return std::to_string(r.emitted); }},
     {"removed", [](const FrameRecord& r) { return std::to_string(r.removed); }},
     {"potential_energy", [](const FrameRecord& r) { return printed("%.6g", r.potentialEnergy); }},
+    {"source_work", [](const FrameRecord& r) { return printed("%.9g", r.sourceWork); }},
 };
 
 class StatsOutput final : public FrameOutput {

@@ -36,6 +36,7 @@ struct FrameRecord {
   double smallestStep = 0, wallSeconds = 0;
   double pressureMax = NAN;      // NaN for a method without pressures
   double potentialEnergy = 0;    // the fluid's, against the tank's floor (potentialEnergy, sim/simulation.h)
+  double sourceWork = 0;         // the sources' work on the fluid since frame 0 (sim/energy_ledger.h)
   size_t emitted = 0, removed = 0;  // particles the emitters added, and the sinks and open faces removed
   PhaseTimes phases;
   std::vector<Wrench> colliderWrenches, bodyWrenches;  // the frame's mean; empty at frame 0

@@ -13,9 +13,12 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "core/scene_fields.h"
 #include "geometry/collider_shape.h"
 #include "geometry/pose.h"
+#include "sim/attractor.h"
+#include "sim/energy_ledger.h"
 #include "sim/fluid_solver.h"
 #include "sim/frame_outputs.h"
 #include "sim/rigid_bodies.h"
@@ -69,6 +72,24 @@ float walkWhileContiguous(const std::vector<float>& sorted, size_t start, float 
                  formatVector(state.velocity[particle], state.dimensions) +
                  " (not finite, outside the domain, or faster than " + limit +
                  " m/s, ten times the fastest the scene can give it)");
+}
+
+// The work the attractor's kick of a step dt from `time` does on the fluid (J): sum of m a . (v + a dt / 2) dt
+// at the step's start, a = a(x). Exact for a method that kicks first (PBF, DFSPH: v += dt a, so the kinetic
+// energy gains m a . v dt + m |a|^2 dt^2 / 2); in the solver's order.
+template <int Dim>
+double attractorWork(const Attractor<Dim>& attractor, const FluidSolver<Dim>& solver, double time, float dt) {
+  const Vec<Dim> centre = attractor.position(time);
+  const std::vector<Vec<Dim>>&x = solver.positions(), &v = solver.velocities();
+  const double work = parallelSum<double>(0, x.size(), [&](size_t b, size_t e) {
+    double sum = 0;
+    for (size_t i = b; i < e; ++i) {
+      const Vec<Dim> a = attractor.acceleration(x[i], centre);
+      sum += double(a.dot(v[i] + 0.5f * dt * a));
+    }
+    return sum;
+  });
+  return solver.particleMass() * work * dt;
 }
 
 // The particles run() starts from: the newest frame of a resumed run (with the method's carried state and the
@@ -139,9 +160,18 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
   ParticleFrame frame;
   FrameRecord record;
   record.particles = &frame;
+  const FluidMethod& registered = fluidMethod(scene.solver.method, scene.source);
+  EnergyLedger ledger(Dim, sceneSpeed(scene), registered.steadier ? registered.steadier : "shorter steps",
+                      scene.emitters.empty() || registered.emittersAccounted);
+  if (!fresh) ledger.resume(dir / "stats.csv", summary.firstFrame);
+  const Attractor<Dim> attractor(scene.attractor);
   auto writeFrame = [&] {
     record.dam = measureDamBreak(scene, frame);
     record.potentialEnergy = potentialEnergy(scene, frame, solver.particleMass());
+    record.sourceWork = ledger.sourceWork();
+    if (record.frame == 0) ledger.start(record.measures.kineticEnergy, record.potentialEnergy);
+    else ledger.check(record.frame, record.measures.kineticEnergy, record.potentialEnergy,
+                      solver.particleMass() * double(frame.size()));
     record.carriedState = solver.carriedState();
     for (const std::unique_ptr<FrameOutput>& output : outputs) output->write(record);
   };
@@ -160,7 +190,10 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     Progress::checkInterrupt();
     const auto frameStart = std::chrono::steady_clock::now();
     solver.phaseTimes() = PhaseTimes{};
-    if (sources) sources->emitted = sources->removed = 0;
+    if (sources) {
+      sources->emitted = sources->removed = 0;
+      sources->work = 0;
+    }
     double time = (f - 1) * frameDuration;
     solver.beginFrame(time);
     if (bodies) {
@@ -186,6 +219,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
         remaining = count == 1 ? 0 : remaining - dt;
       }
       long badBody = -1;
+      if (attractor.active()) ledger.add(attractorWork(attractor, solver, time, dt));
       const long bad = coupledStep<Dim>(solver, bodies.get(), dt, time, badBody);
       time += dt;
       if (badBody >= 0)
@@ -217,6 +251,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     if (sources) {
       record.emitted = sources->emitted;
       record.removed = sources->removed;
+      ledger.add(sources->work);
     }
     record.phases = solver.phaseTimes();
     record.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart).count();
@@ -225,6 +260,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
       const auto firstBody = wrenches.begin() + std::ptrdiff_t(scene.colliders.size());
       record.bodyWrenches.assign(firstBody, wrenches.end());
       record.colliderWrenches.assign(wrenches.begin(), firstBody);
+      for (const Wrench& w : wrenches) ledger.add(w.work);
     }
     writeFrame();
     progress.advance();
@@ -290,12 +326,9 @@ void checkSimulationStart(const Scene& scene, std::shared_ptr<const ColliderShap
 }
 
 double potentialEnergy(const Scene& scene, const ParticleFrame& frame, double particleMass) {
-  const int d = scene.dimensions;
-  Eigen::Vector3d g = Eigen::Vector3d::Zero(), corner = Eigen::Vector3d::Zero();
-  g.head(d) = scene.gravity.head(d);
-  for (int k = 0; k < d; ++k) corner[k] = g[k] < 0 ? scene.domain.min[k] : scene.domain.max[k];
+  const GravityPotential potential(scene);
   double sum = 0;
-  for (const Eigen::Vector3f& x : frame.position) sum += g.dot(corner - x.cast<double>());
+  for (const Eigen::Vector3f& x : frame.position) sum += potential.at(x.cast<double>());
   return particleMass * sum;
 }
 

@@ -88,7 +88,7 @@ void resolveSolverDefaults(Scene& scene) {
   if (method.resolveDefaults) method.resolveDefaults(scene);
 }
 
-double runawaySpeed(const Scene& scene) {
+double sceneSpeed(const Scene& scene) {
   const int d = scene.dimensions;
   const double diagonal = (scene.domain.max - scene.domain.min).head(d).norm();
   double fluid = 0, bodies = 0, colliders = 0, attractor = 0;
@@ -114,9 +114,13 @@ double runawaySpeed(const Scene& scene) {
     attractor = std::sqrt(std::abs(scene.attractor.strength) * scene.attractor.radius) + moving;
   }
   const double fall = std::sqrt(2 * scene.gravity.head(d).norm() * diagonal);
+  return fluid + bodies + 2 * colliders + attractor + fall;
+}
+
+double runawaySpeed(const Scene& scene) {
   const double solver = scene.particle_spacing * scene.output.fps *
                         fluidMethod(scene.solver.method, scene.source).pushesPerFrame(scene);
-  return 10 * (fluid + bodies + 2 * colliders + attractor + fall + solver);
+  return 10 * (sceneSpeed(scene) + solver);
 }
 
 size_t bytesPerParticleEstimate(int dimensions, const std::string& method) {

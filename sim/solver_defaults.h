@@ -44,6 +44,8 @@ void resolveSolverDefaults(Scene& scene);
 // (sqrt(2 g L)), and the method's own push (a spacing each of FluidMethod::pushesPerFrame). Stable runs stay
 // well under a tenth of it; a blow-up passes it within a few steps.
 double runawaySpeed(const Scene& scene);
+// The fastest the scene itself can move the fluid: runawaySpeed's terms but the method's push, not times ten.
+double sceneSpeed(const Scene& scene);
 
 // Bytes the scene's method needs per particle at peak (FluidMethod::bytesPerParticle).
 size_t bytesPerParticleEstimate(int dimensions, const std::string& method);

@@ -153,7 +153,9 @@ FluidSources<Dim>::FluidSources(const Scene& scene, uint32_t firstId, double tim
       spacing_(static_cast<float>(scene.particle_spacing)),
       domainMin_(toVec<Dim>(scene.domain.min)),
       domainMax_(toVec<Dim>(scene.domain.max)),
-      nextId_(firstId) {
+      nextId_(firstId),
+      lastTime_(time),
+      potential_(scene) {
   for (int axis = 0; axis < Dim; ++axis)
     for (int upper = 0; upper < 2; ++upper)
       if (scene.isOpen(axis, upper)) openFaces_ |= 1 << (2 * axis + upper);
@@ -301,6 +303,11 @@ void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
       if (slot >= 0 || k >= long(heldFrom)) {  // held, or water to move out
         if (slot >= 0) held_[size_t(slot)] = 1;
         at = slot >= 0 ? heldAt_[size_t(slot)] : VecD(at + outOfNozzle(r, along, across, d, reach, depth));
+        // Held back on its site against the water's push, m (v - U) / dt over the last step (U the velocity the
+        // site gave it, as its site has now), the nozzle works on the water: that push times the way back.
+        if (slot >= 0 && stepTime_ > 0)
+          heldWork_ -= solver.particleMass() / stepTime_ *
+                       double((solver.velocities()[i] - heldVelocity_[size_t(slot)]).dot(at - x[i]));
         edit_.steer.push_back(static_cast<uint32_t>(i));
         edit_.steerPosition.push_back(at);
         edit_.steerVelocity.push_back(slot >= 0 ? heldVelocity_[size_t(slot)] : solver.velocities()[i]);
@@ -309,8 +316,10 @@ void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
     nearby_.push_back(at);
   }
 
-  // The layers due by now, each site unless it is blocked.
+  // The layers due by now, each site unless it is blocked. Each new particle is pushed in against the water
+  // standing above the face: its flow work, p V = m g (the depth there), goes to the ledger.
   Colliders<Dim>& colliders = solver.colliders();
+  float above = NAN;
   for (size_t k = layers_[e]; k < due; ++k)
     for (size_t j = 0; j < sites; ++j) {
       const uint32_t id = nextId_++;
@@ -324,6 +333,8 @@ void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
       for (size_t q = 0; q < nearby_.size() && !blocked; ++q)
         blocked = (nearby_[q] - p).squaredNorm() < radius * radius;
       if (blocked || inSink(p)) continue;
+      if (!std::isfinite(above)) above = waterAbove(c, reach, x);
+      flowWork_ += solver.particleMass() * scene_.gravity.norm() * above;
       edit_.addPosition.push_back(p);
       edit_.addVelocity.push_back(velocity);
       edit_.addId.push_back(id);
@@ -334,6 +345,9 @@ void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
 template <int Dim>
 void FluidSources<Dim>::apply(FluidSolver<Dim>& solver, double time) {
   edit_.clear();
+  flowWork_ = heldWork_ = 0;
+  stepTime_ = time - lastTime_;
+  lastTime_ = time;
   placeSinks(time);
   const std::vector<VecD>& x = solver.positions();
   const size_t n = x.size();
@@ -344,7 +358,43 @@ void FluidSources<Dim>::apply(FluidSolver<Dim>& solver, double time) {
   for (size_t e = 0; e < emitters_.size(); ++e) emit(e, solver, time);
   emitted += edit_.addPosition.size();
   removed += edit_.remove.size();
-  if (!edit_.empty()) solver.editParticles(edit_);
+  if (edit_.empty()) return;
+  work += editEnergy(solver);
+  solver.editParticles(edit_);
+}
+
+template <int Dim>
+float FluidSources<Dim>::waterAbove(const VecD& c, float reach, const std::vector<VecD>& x) const {
+  const double g = scene_.gravity.norm();
+  if (!(g > 0)) return 0;
+  const VecD up = toVec<Dim>(-scene_.gravity / g);
+  const float s = spacing_, gap = 2 * s;
+  std::vector<float> heights;
+  for (const VecD& p : x) {
+    const float height = (p - c).dot(up);
+    if (height > -s && (p - c - height * up).norm() < reach + s) heights.push_back(height);
+  }
+  std::sort(heights.begin(), heights.end());
+  if (heights.empty() || heights.front() > gap) return 0;
+  size_t i = 0;
+  while (i + 1 < heights.size() && heights[i + 1] - heights[i] < gap) ++i;
+  return std::max(0.0f, heights[i] + 0.5f * s);
+}
+
+template <int Dim>
+double FluidSources<Dim>::editEnergy(const FluidSolver<Dim>& solver) const {
+  const std::vector<VecD>&x = solver.positions(), &v = solver.velocities();
+  const double m = solver.particleMass();
+  double energy = 0;
+  for (const uint32_t i : edit_.remove) energy -= potential_.energy<Dim>(x[i], v[i], m);
+  for (size_t k = 0; k < edit_.steer.size(); ++k) {
+    const uint32_t i = edit_.steer[k];
+    energy += potential_.energy<Dim>(edit_.steerPosition[k], edit_.steerVelocity[k], m) -
+              potential_.energy<Dim>(x[i], v[i], m);
+  }
+  for (size_t k = 0; k < edit_.addPosition.size(); ++k)
+    energy += potential_.energy<Dim>(edit_.addPosition[k], edit_.addVelocity[k], m);
+  return energy + flowWork_ + heldWork_;
 }
 
 size_t mostEmittedParticles(const Scene& scene, double time) {

@@ -19,6 +19,7 @@
 #include "core/scene.h"
 #include "geometry/collider_shape.h"
 #include "geometry/pose.h"
+#include "sim/energy_ledger.h"
 #include "sim/fluid_solver.h"
 
 namespace surge {
@@ -68,12 +69,20 @@ class FluidSources {
   // sinks hold every particle of the initial fluid.
   void checkStart(const std::vector<VecD>& particles, const Colliders<Dim>& colliders) const;
 
-  // After the step that ended at `time`: the edit to apply (also counted in emitted and removed).
+  // After the step that ended at `time`: the edit to apply (also counted in emitted and removed, and its energy
+  // in work).
   void apply(FluidSolver<Dim>& solver, double time);
   size_t emitted = 0, removed = 0;  // since the counts were last cleared
+  // The mechanical energy the edits brought in since it was last cleared (J): the new particles', the work of
+  // pushing them in under water (their flow work), the change of the steered ones' and the work of holding the
+  // nozzle's layers on their sites against the water, less the removed particles' (sim/energy_ledger.h).
+  double work = 0;
 
  private:
   void emit(size_t e, FluidSolver<Dim>& solver, double time);
+  double editEnergy(const FluidSolver<Dim>& solver) const;
+  // How deep the water stands above c (along -gravity), in a column of `reach` around it: 0 where none does.
+  float waterAbove(const VecD& c, float reach, const std::vector<VecD>& x) const;
   VecD outOfNozzle(const VecD& r, float along, float across, const VecD& d, float reach, float depth) const;
   bool inSink(const VecD& p) const;
   void placeSinks(double time);  // the moving sinks' poses and bounds at `time`
@@ -87,7 +96,10 @@ class FluidSources {
   std::vector<EmitterSchedule> emitters_;
   std::vector<size_t> layers_;  // layers each emitter has made
   uint32_t nextId_;
+  double lastTime_, stepTime_ = 0;  // the last apply's time, and the step since the one before
   std::vector<std::unique_ptr<Sink>> sinks_;
+  GravityPotential potential_;
+  double flowWork_ = 0, heldWork_ = 0;  // this edit's new particles' flow work, and the held layers' work
   ParticleEdit<Dim> edit_;  // reused: no allocation once its capacity suffices
   std::vector<VecD> nearby_;    // where the particles near an emitter's face are after the edit
   std::vector<VecD> heldAt_, heldVelocity_;  // the nozzle's sites, by layer, and their velocities

@@ -41,6 +41,7 @@ int wcsphPushesPerFrame(const Scene&) { return 1; }
 // Less than PBF's 400 and 250 bytes a particle (no stored pair factors), counted as those.
 const FluidMethod kWcsphMethod = {"wcsph", "weakly compressible SPH (Monaghan 1994, Becker & Teschner 2007)",
     &makeMethod<WcsphSolver, 2>, &makeMethod<WcsphSolver, 3>, 250, 400,
-    &wcsphPushesPerFrame, nullptr, nullptr, &declareWcsphKeys};
+    &wcsphPushesPerFrame, nullptr, nullptr, &declareWcsphKeys,
+    "a smaller solver.cfl or solver.time_step", false};
 
 }  // namespace surge

@@ -49,7 +49,7 @@ TEST(StudyCommand, SweepWritesOneRowPerRunAndPicksTheCostliestAsReference) {
   const fs::path out = fs::path(testing::TempDir()) / "surge_study";
   fs::remove_all(out);
   const SurgeResult r = runSurge("study '" + scene.string() + "' --quiet --sweep solver.iterations=1,4 --sweep " +
-                                 "solver.substeps=20,40 --frames 8 --out " + out.string());
+                                 "solver.substeps=20,30 --frames 8 --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.err;
   const auto rows = readCsv(out / "study.csv");
   ASSERT_EQ(rows.size(), 5u);
@@ -58,20 +58,21 @@ TEST(StudyCommand, SweepWritesOneRowPerRunAndPicksTheCostliestAsReference) {
   const int reference = column(header, "reference"), error = column(header, "error"), steps = column(header, "steps");
   const int cpu = column(header, "cpu_seconds"), peak = column(header, "peak_mb"), status = column(header, "status");
   ASSERT_GE(std::min({iterations, substeps, reference, error, steps, cpu, peak, status}), 0);
-  // The first sweep varies slowest.
-  EXPECT_EQ(rows[1][iterations] + rows[1][substeps] + rows[2][substeps] + rows[3][iterations], "120404");
+  // The first sweep varies slowest. (At 40 substeps PBF's s_corr, a push a step, gives this small dam break 2.6%
+  // of its energy from nowhere, and the energy stop ends the run: docs/speed-accuracy.md.)
+  EXPECT_EQ(rows[1][iterations] + rows[1][substeps] + rows[2][substeps] + rows[3][iterations], "120304");
   for (size_t i = 1; i < rows.size(); ++i) {
     EXPECT_EQ(rows[i][status], "ok");
     // Both counts are above what the flow needs (PBF's steps are never longer than its CFL and depth steps).
     EXPECT_EQ(std::stoi(rows[i][steps]), 8 * std::stoi(rows[i][substeps]));
     EXPECT_GT(std::stod(rows[i][cpu]), 0);
     EXPECT_GT(std::stod(rows[i][peak]), 1);
-    // The reference (4 iterations, 40 substeps: the most work) compares as 0; the others differ from it.
+    // The reference (4 iterations, 30 substeps: the most work) compares as 0; the others differ from it.
     EXPECT_EQ(rows[i][reference], i == 4 ? "1" : "0");
     if (i == 4) EXPECT_LT(std::stod(rows[i][error]), 1e-9);
     else EXPECT_GT(std::stod(rows[i][error]), 1e-6);
   }
-  EXPECT_TRUE(fs::exists(out / "runs" / "003_solver.iterations=4,solver.substeps=40" / "stats.csv"));
+  EXPECT_TRUE(fs::exists(out / "runs" / "003_solver.iterations=4,solver.substeps=30" / "stats.csv"));
 }
 
 // Render settings swept: the scene is simulated and surfaced once (base/), each run renders it, and its error
