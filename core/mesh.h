@@ -14,6 +14,7 @@ struct TriangleMesh {
   std::vector<Eigen::Vector3f> positions;
   std::vector<Eigen::Vector3f> normals;  // one per vertex, or empty
   std::vector<std::array<uint32_t, 3>> triangles;
+  std::vector<Eigen::Vector3f> velocities;  // one per vertex (a surface's, for motion blur), or empty
 };
 
 }  // namespace surge

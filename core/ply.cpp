@@ -333,17 +333,21 @@ ParticleFrame readParticlePly(const fs::path& path) {
 
 void writeMeshPly(const fs::path& path, const TriangleMesh& mesh) {
   const bool normals = mesh.normals.size() == mesh.positions.size() && !mesh.positions.empty();
+  const bool velocities = mesh.velocities.size() == mesh.positions.size() && !mesh.positions.empty();
   writeFileAtomically(path, [&](std::ostream& out) {
     out << "ply\nformat binary_little_endian 1.0\ncomment surge surface mesh\n"
         << "element vertex " << mesh.positions.size() << "\n"
         << "property float x\nproperty float y\nproperty float z\n";
     if (normals) out << "property float nx\nproperty float ny\nproperty float nz\n";
+    if (velocities) out << "property float vx\nproperty float vy\nproperty float vz\n";
     out << "element face " << mesh.triangles.size() << "\n"
         << "property list uchar uint vertex_indices\nend_header\n";
     for (size_t i = 0; i < mesh.positions.size(); ++i) {
       for (int k = 0; k < 3; ++k) put(out, mesh.positions[i][k]);
       if (normals)
         for (int k = 0; k < 3; ++k) put(out, mesh.normals[i][k]);
+      if (velocities)
+        for (int k = 0; k < 3; ++k) put(out, mesh.velocities[i][k]);
     }
     for (const auto& t : mesh.triangles) {
       put<uint8_t>(out, 3);
@@ -358,8 +362,8 @@ TriangleMesh readMeshPly(const fs::path& path) {
   TriangleMesh mesh;
   size_t vertexIndex = 0, faceIndex = 0;
   if (!findElement(file, "vertex", &vertexIndex)) throw InputError(where, "element vertex", "missing");
-  const auto columns = readColumns(file, vertexIndex, {"x", "y", "z", "nx", "ny", "nz"},
-                                   {false, false, false, true, true, true}, where);
+  const auto columns = readColumns(file, vertexIndex, {"x", "y", "z", "nx", "ny", "nz", "vx", "vy", "vz"},
+                                   {false, false, false, true, true, true, true, true, true}, where);
   const size_t n = file.elements[vertexIndex].count;
   mesh.positions.resize(n);
   for (size_t i = 0; i < n; ++i)
@@ -368,6 +372,11 @@ TriangleMesh readMeshPly(const fs::path& path) {
     mesh.normals.resize(n);
     for (size_t i = 0; i < n; ++i)
       mesh.normals[i] = Eigen::Vector3f(float(columns[3][i]), float(columns[4][i]), float(columns[5][i]));
+  }
+  if (!columns[6].empty() && !columns[7].empty() && !columns[8].empty()) {
+    mesh.velocities.resize(n);
+    for (size_t i = 0; i < n; ++i)
+      mesh.velocities[i] = Eigen::Vector3f(float(columns[6][i]), float(columns[7][i]), float(columns[8][i]));
   }
   const PlyElement* faces = findElement(file, "face", &faceIndex);
   if (!faces) return mesh;

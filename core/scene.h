@@ -166,6 +166,7 @@ struct SurfaceSettings {
   std::string method = "spheres";      // spheres, smooth_spheres or anisotropic (surface/surfacer.h)
   int smoothing_steps = 2;             // mean-curvature steps of tools::LevelSetFilter
   int write_velocity = 0;              // 1: the VDB also holds a vector grid "v"
+  int mesh_velocity = -1;              // 1: mesh vertices carry velocities; -1: on for render.quality final
   int write_points = 0;                // 1: the VDB also holds a PointDataGrid "points" with attribute "v"
   int write_obj = 0;                   // 1: an OBJ mesh beside the PLY
 };

@@ -283,6 +283,11 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.integer("write_points", s.surface.write_points,
               atLeast(0, "1: the VDB also holds the particles as a PointDataGrid `points` with a `v` attribute", "", 1));
     v.integer("write_obj", s.surface.write_obj, atLeast(0, "1: write an OBJ mesh beside each PLY mesh", "", 1));
+    v.integer("mesh_velocity", s.surface.mesh_velocity,
+              atLeast(-1,
+                      "1: each mesh vertex carries the particles' velocity there (PLY vx vy vz, kernel-averaged), "
+                      "for motion blur; 0: none; -1: as render.quality, on for final",
+                      "", 1));
   });
   v.group("render", info("the renderer"), [&] {
     v.integer("width", s.render.width, atLeast(16, "image width", "pixels", 16384));

@@ -26,6 +26,7 @@
 #include "core/parallel.h"
 #include "surface/anisotropy.h"
 #include "surface/collider_clip.h"
+#include "surface/mesh_velocity.h"
 #include "surface/narrow_band.h"
 #include "surface/particle_field.h"
 #include "surface/vdb_output.h"
@@ -501,10 +502,13 @@ SurfaceStats surfaceFrameWith(const ParticleFrame& frame, const Scene& scene, co
   VdbExtras extras;
   BlockField velocity;
   std::vector<Eigen::Vector3f> x, v;
-  if (scene.surface.write_velocity || scene.surface.write_points) {
+  const bool meshVelocity =
+      scene.surface.mesh_velocity == 1 || (scene.surface.mesh_velocity < 0 && scene.render.quality == "final");
+  if (scene.surface.write_velocity || scene.surface.write_points || meshVelocity) {
     x = slabPositions(frame, p, frame.position, true);
     v = slabPositions(frame, p, frame.velocity, false);
   }
+  if (meshVelocity) sampleVertexVelocities(mesh, x, v, float(kZbSupport * p.spacing));
   if (scene.surface.write_velocity) {
     // The Shepard average of the particle velocities (ZB05 weights, support 2 spacings) on every voxel of the
     // surface's leaves, where a renderer's motion blur or a re-simulation looks them up.
