@@ -87,8 +87,6 @@ std::string writeStudyPlots(const fs::path& dir, const std::vector<Sweep>& sweep
 // The runs on the Pareto front of (CPU seconds, error): none cheaper is at least as accurate. Sorted by CPU.
 std::vector<int> paretoFront(const std::vector<StudyRun>& runs);
 
-// The fields of one line of the CSV files surge writes (no quoting: only study.csv quotes, and is not read).
-std::vector<std::string> splitCsvLine(const std::string& line);
 // printf of one number with `spec`; "" for NaN (an empty CSV field).
 std::string format(double value, const char* spec = "%.6g");
 // Writes `text` to `script` and runs gnuplot on it (its output into the script's name with .log). Returns "" or

@@ -93,15 +93,6 @@ std::string label(const StudyRun& run) {
 
 }  // namespace
 
-std::vector<std::string> splitCsvLine(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream in(line);
-  std::string field;
-  while (std::getline(in, field, ',')) fields.push_back(field);
-  if (!line.empty() && line.back() == ',') fields.push_back("");
-  return fields;
-}
-
 std::string format(double value, const char* spec) {
   if (std::isnan(value)) return "";
   char text[64];

@@ -59,5 +59,7 @@ void checkOutputFolder(const fs::path& dir);
 
 // Reads a whole text file; throws InputError naming the file if it cannot be read.
 std::string readTextFile(const fs::path& path);
+// The fields of one line of the CSV files surge writes (no quoting: only study.csv quotes, and is not read).
+std::vector<std::string> splitCsvLine(const std::string& line);
 
 }  // namespace surge

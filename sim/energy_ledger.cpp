@@ -19,15 +19,6 @@ double asPrinted(double value, const char* format = "%.9g") {
   return std::strtod(text, nullptr);
 }
 
-std::vector<std::string> csvFields(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream in(line);
-  std::string field;
-  while (std::getline(in, field, ',')) fields.push_back(field);
-  if (!line.empty() && line.back() == ',') fields.emplace_back();
-  return fields;
-}
-
 }  // namespace
 
 GravityPotential::GravityPotential(const Scene& scene) {
@@ -47,7 +38,7 @@ void EnergyLedger::resume(const fs::path& stats, int frame) {
   std::stringstream in(text);
   std::string line;
   std::getline(in, line);
-  const std::vector<std::string> header = csvFields(line);
+  const std::vector<std::string> header = splitCsvLine(line);
   auto column = [&](const char* name) {
     for (size_t c = 0; c < header.size(); ++c)
       if (header[c] == name) return long(c);
@@ -56,7 +47,7 @@ void EnergyLedger::resume(const fs::path& stats, int frame) {
   const long kinetic = column("kinetic_energy"), potential = column("potential_energy"), work = column("source_work");
   bool started = false;
   while (std::getline(in, line)) {
-    const std::vector<std::string> row = csvFields(line);
+    const std::vector<std::string> row = splitCsvLine(line);
     if (row.empty() || std::atoi(row[0].c_str()) > frame) continue;
     auto value = [&](long c) { return c >= 0 && size_t(c) < row.size() ? std::strtod(row[c].c_str(), nullptr) : 0.0; };
     const double energy = value(kinetic) + value(potential);
@@ -83,8 +74,9 @@ void EnergyLedger::check(int frame, double kinetic, double potential, double mas
   std::snprintf(line, sizeof line,
                 "the fluid gained energy from nowhere by frame %d: its mechanical energy is %.4g %s, %.4g %s above "
                 "frame 0's %.4g %s and what its sources did (%.4g %s), beyond the %.4g %s its method's error allows "
-                "(2%% of the most it held); give it %s",
-                frame, energy, unit, gain, unit, start_, unit, work_, unit, tolerance(), unit, remedy_.c_str());
+                "(%g%% of the most it held); give it %s",
+                frame, energy, unit, gain, unit, start_, unit, work_, unit, tolerance(), unit, 100 * kTolerance,
+                remedy_.c_str());
   throw RunError(line);
 }
 
