@@ -32,6 +32,7 @@ void say(const CommonOptions& options, const std::string& line);
 // Each adds a subcommand to `app` and returns nothing; the command's callback does the work.
 void addRunCommand(CLI::App& app);
 void addSimCommand(CLI::App& app);
+void addWhitewaterCommand(CLI::App& app);
 void addSurfaceCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addVideoCommand(CLI::App& app);
@@ -42,6 +43,9 @@ void addStudyCommand(CLI::App& app);
 // With `resume` (surge sim --resume, surge run --resume) each stage picks up where a stopped run left off: the
 // simulation from its last complete frame, the surface and render stages skipping the frames already up to date.
 void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const CommonOptions& options);
+// The whitewater stage does nothing for a scene whose whitewater.enabled is 0.
+void runWhitewaterStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options,
+                        bool resume = false);
 void runSurfaceStage(const Scene& scene, const fs::path& dir, const FrameRange& range, const CommonOptions& options,
                      bool resume = false);
 // renderer: "embree", "gl", or empty for the default of the scene's dimension.

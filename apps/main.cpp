@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   addRunCommand(app);
   addSimCommand(app);
+  addWhitewaterCommand(app);
   addSurfaceCommand(app);
   addRenderCommand(app);
   addVideoCommand(app);

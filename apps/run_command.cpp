@@ -65,6 +65,7 @@ void addRunCommand(CLI::App& app) {
     if (options->slurm.enabled) return submitRun(scene, dir, *options);
     try {
       runSimStage(scene, dir, options->resume, options->common);
+      runWhitewaterStage(scene, dir, FrameRange{}, options->common, options->resume);
       runSurfaceStage(scene, dir, FrameRange{}, options->common, options->resume);
       runRenderStage(scene, dir, FrameRange{}, options->common, options->renderer, options->resume);
     } catch (const Interrupted&) {

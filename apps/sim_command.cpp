@@ -40,6 +40,7 @@ void checkResumable(const fs::path& previous, const std::string& previousJson, c
 void removeLaterStagesFrames(const fs::path& dir) {
   // A new simulation: whatever the later stages made from an earlier one in this folder is stale (a shorter run
   // would otherwise end in a video of the older run's later frames).
+  removeFrames(dir, "whitewater", {"ply"});
   removeFrames(dir, "surface", {"vdb", "ply", "obj"});
   removeFrames(dir, "frames", {"png"});
 }

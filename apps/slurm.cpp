@@ -108,12 +108,24 @@ std::vector<SlurmJob> runJobs(const Scene& scene, const fs::path& scenePath, con
   for (const std::string& assignment : overrides) sim += " --set " + shellQuote(assignment);
   jobs.push_back({"sim", sim + "\n", ""});
 
+  // Whitewater (when the scene has it): one job after the simulation, each frame made from the one before; the
+  // surfaces then wait for it (no streaming: a surface frame holds its frame's whitewater).
+  const bool whitewater = scene.whitewater.enabled != 0;
+  if (whitewater) {
+    std::string white = header("surge-whitewater-" + scene.name, dir, "whitewater_%j.out", o, "");
+    white += "# Spray, foam and bubbles, one job; requeued, it goes on from its last complete frame.\n";
+    white += "exec " + surge + " whitewater " + folder + " --resume" + kThreads + "\n";
+    jobs.push_back({"whitewater", white, "afterok:%0"});
+  }
+  const std::string before = whitewater ? "%1" : "%0", surfaces = whitewater ? "%2" : "%1",
+                    renders = whitewater ? "%3" : "%2";
+
   std::string surface = header("surge-surface-" + scene.name, dir, "surface_%A_%a.out", o, array);
   surface += "# Frames first..last of chunk SLURM_ARRAY_TASK_ID; up-to-date frames are left as they are.\n";
   surface += chunkLines(o.chunk);
   surface += "exec " + surge + " surface " + folder + " --frames \"$first:$last\" --resume" + kThreads +
-             (o.stream ? " --wait" : "") + "\n";
-  jobs.push_back({"surface", surface, (o.stream ? "after:%0" : "afterok:%0")});
+             (o.stream && !whitewater ? " --wait" : "") + "\n";
+  jobs.push_back({"surface", surface, (o.stream && !whitewater ? "after:" : "afterok:") + before});
 
   std::string render = header("surge-render-" + scene.name, dir, "render_%A_%a.out", o, array);
   render += "# The same chunk's images, once its surfaces are done (aftercorr).\n";
@@ -121,11 +133,11 @@ std::vector<SlurmJob> runJobs(const Scene& scene, const fs::path& scenePath, con
   render += "exec " + surge + " render " + folder + " --frames \"$first:$last\" --resume" + kThreads;
   if (!renderer.empty()) render += " --renderer " + shellQuote(renderer);
   if (!quality.empty()) render += " --quality " + shellQuote(quality);
-  jobs.push_back({"render", render + "\n", "aftercorr:%1"});
+  jobs.push_back({"render", render + "\n", "aftercorr:" + surfaces});
 
   std::string video = header("surge-video-" + scene.name, dir, "video_%j.out", o, "");
   video += "exec " + surge + " video " + folder + kThreads + "\n";
-  jobs.push_back({"video", video, "afterok:%2"});
+  jobs.push_back({"video", video, "afterok:" + renders});
   return jobs;
 }
 

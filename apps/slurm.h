@@ -3,7 +3,7 @@
 // dependencies order them, and its requeue restarts a killed task, which then redoes only what is missing
 // (every stage runs with --resume). docs/cluster.md has the commands and what happens when a task fails.
 //
-//   surge run:   sim (one job) -> surface (array over chunks of --chunk frames, afterok:sim, or with --stream
+//   surge run:   sim (one job) -> whitewater (one job, afterok:sim, when the scene has it) -> surface (array over chunks of --chunk frames, afterok:sim, or with --stream
 //                after:sim, each task surfacing its frames as the simulation writes them) -> render (array,
 //                aftercorr:surface: a chunk renders once its own surfaces are done) -> video (afterok:render)
 //   surge study: one array task a sweep point -> report (afterany: a run that diverged is a result too)

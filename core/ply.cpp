@@ -331,6 +331,62 @@ ParticleFrame readParticlePly(const fs::path& path) {
   return frame;
 }
 
+void writeDiffusePly(const fs::path& path, const DiffuseFrame& frame) {
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out << "ply\nformat binary_little_endian 1.0\ncomment surge whitewater frame\n"
+        << "comment dimensions " << frame.dimensions << "\n"
+        << "comment next_id " << frame.nextId << "\n"
+        << "element vertex " << frame.size() << "\n"
+        << "property float x\nproperty float y\nproperty float z\n"
+        << "property float vx\nproperty float vy\nproperty float vz\n"
+        << "property uint id\nproperty uchar type\nproperty float lifetime\nend_header\n";
+    constexpr size_t kRecord = 24 + 4 + 1 + 4;
+    std::string buffer(frame.size() * kRecord, '\0');
+    char* p = buffer.data();
+    for (size_t i = 0; i < frame.size(); ++i, p += kRecord) {
+      const float values[6] = {frame.position[i].x(), frame.position[i].y(), frame.position[i].z(),
+                               frame.velocity[i].x(), frame.velocity[i].y(), frame.velocity[i].z()};
+      std::memcpy(p, values, sizeof values);
+      std::memcpy(p + 24, &frame.id[i], 4);
+      std::memcpy(p + 28, &frame.type[i], 1);
+      std::memcpy(p + 29, &frame.lifetime[i], 4);
+    }
+    out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+  });
+}
+
+DiffuseFrame readDiffusePly(const fs::path& path) {
+  const std::string where = path.string();
+  const PlyFile file = parsePly(path);
+  size_t index = 0;
+  if (!findElement(file, "vertex", &index)) throw InputError(where, "element vertex", "missing");
+  const auto columns =
+      readColumns(file, index, {"x", "y", "z", "vx", "vy", "vz", "id", "type", "lifetime"},
+                  std::vector<bool>(9, false), where);
+  DiffuseFrame frame;
+  for (const std::string& comment : file.comments) {
+    if (comment.rfind("dimensions ", 0) == 0) frame.dimensions = comment.substr(11) == "2" ? 2 : 3;
+    if (comment.rfind("next_id ", 0) == 0) frame.nextId = uint32_t(std::strtoul(comment.c_str() + 8, nullptr, 10));
+  }
+  const size_t n = file.elements[index].count;
+  frame.resize(n);
+  const char* names[9] = {"x", "y", "z", "vx", "vy", "vz", "id", "type", "lifetime"};
+  for (size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 9; ++k)
+      if (!std::isfinite(float(columns[size_t(k)][i])))
+        throw InputError(where, "vertex " + std::to_string(i) + " " + names[k], "not a finite number");
+    if (columns[7][i] > kBubble)
+      throw InputError(where, "vertex " + std::to_string(i) + " type", "must be 0 (spray), 1 (foam) or 2 (bubble)");
+    frame.position[i] = Eigen::Vector3f(float(columns[0][i]), float(columns[1][i]), float(columns[2][i]));
+    frame.velocity[i] = Eigen::Vector3f(float(columns[3][i]), float(columns[4][i]), float(columns[5][i]));
+    frame.id[i] = uint32_t(columns[6][i]);
+    frame.type[i] = uint8_t(columns[7][i]);
+    frame.lifetime[i] = float(columns[8][i]);
+    frame.nextId = std::max(frame.nextId, frame.id[i] + 1);
+  }
+  return frame;
+}
+
 void writeMeshPly(const fs::path& path, const TriangleMesh& mesh) {
   const bool normals = mesh.normals.size() == mesh.positions.size() && !mesh.positions.empty();
   const bool velocities = mesh.velocities.size() == mesh.positions.size() && !mesh.positions.empty();

@@ -34,6 +34,31 @@ void writeParticlePly(const fs::path& path, const ParticleFrame& frame);
 // Throws InputError naming the file and the header line or property at fault.
 ParticleFrame readParticlePly(const fs::path& path);
 
+// A whitewater frame (whitewater/frame_NNNNN.ply): the diffuse particles as x y z vx vy vz id type lifetime,
+// and the next id to give in a comment, so that the stage continues from a frame as from memory.
+enum DiffuseType : uint8_t { kSpray = 0, kFoam = 1, kBubble = 2 };
+struct DiffuseFrame {
+  int dimensions = 3;
+  uint32_t nextId = 0;
+  std::vector<Eigen::Vector3f> position;
+  std::vector<Eigen::Vector3f> velocity;
+  std::vector<uint32_t> id;
+  std::vector<uint8_t> type;   // DiffuseType
+  std::vector<float> lifetime;  // seconds left
+
+  size_t size() const { return position.size(); }
+  void resize(size_t n) {
+    position.resize(n);
+    velocity.resize(n);
+    id.resize(n);
+    type.resize(n);
+    lifetime.resize(n);
+  }
+};
+
+void writeDiffusePly(const fs::path& path, const DiffuseFrame& frame);
+DiffuseFrame readDiffusePly(const fs::path& path);
+
 void writeMeshPly(const fs::path& path, const TriangleMesh& mesh);
 TriangleMesh readMeshPly(const fs::path& path);
 

@@ -508,9 +508,12 @@ std::string sceneToJson(const Scene& scene) {
 
 fs::path writeStageSettings(const fs::path& dir, const std::string& stage, const Scene& scene,
                             const std::string& extra) {
-  if (stage != "surface" && stage != "render") throw std::logic_error("writeStageSettings: no stage '" + stage + "'");
-  // The keys both stages read, and the stage's own section.
-  const std::vector<std::string> keys = {"dimensions", "domain", "particle_spacing", "colliders", "bodies", stage};
+  if (stage != "surface" && stage != "render" && stage != "whitewater")
+    throw std::logic_error("writeStageSettings: no stage '" + stage + "'");
+  // The keys the stages read, and the stage's own section; the later stages read the whitewater where there is.
+  std::vector<std::string> keys = {"dimensions", "domain", "particle_spacing", "colliders", "bodies", stage};
+  if (stage == "whitewater") keys = {"dimensions", "domain", "particle_spacing", "gravity", "solver", stage};
+  else if (scene.whitewater.enabled) keys.push_back("whitewater");
   Scene copy = scene;
   JsonWriter writer(copy);
   visitScene(copy, writer);

@@ -171,6 +171,35 @@ struct SurfaceSettings {
   int write_obj = 0;                   // 1: an OBJ mesh beside the PLY
 };
 
+// Spray, foam and bubbles made from the saved particle frames (whitewater/, after Ihmsen, Akinci, Akinci and
+// Teschner 2012). Thresholds and rates are relative to the scene, so that the same scene at any size makes
+// whitewater alike: U is the speed of a fall through the tank's diagonal (or the fluid's fastest start, without
+// gravity), T = diagonal / U its time, S the kernel's sum over the rest lattice. 0 in the file: derived (resolved).
+struct WhitewaterSettings {
+  int enabled = 0;
+  double trapped_air_min = 0.02, trapped_air_max = 0.2;  // on v_diff / (U S) (Ihmsen's eq. 2)
+  double wave_crest_min = 0.1, wave_crest_max = 0.5;     // on kappa / S (eq. 4-7)
+  double kinetic_min = 0.01, kinetic_max = 0.2;          // on (|v| / U)^2 (eq. 8)
+  double trapped_air_rate = 8;  // diffuse particles a fluid particle makes per T at full potentials (eq. 9)
+  double wave_crest_rate = 8;
+  double lifetime_min = 0, lifetime_max = 0;  // s, drawn per particle, spent while foam or a bubble; 0: 1 T and 3 T
+  double spray_drag = 0;       // 1/s, air drag on spray; 0: |g| / (2 U), a terminal fall of 2 U
+  double bubble_buoyancy = 4;  // times |g|
+  double bubble_drag = 0;      // 1/s, toward the fluid's velocity; 0: a terminal rise of U / 10
+  int spray_neighbors = 0;     // fewer fluid neighbours: spray; 0: a fifth of the rest lattice's
+  int bubble_neighbors = 0;    // more: a bubble; between: foam; 0: three fifths of the rest lattice's
+  double particle_size = 0;    // m, the radius drawn; 0: particle_spacing / 4
+  int substeps = 0;            // per frame; 0: so that nothing moves more than a kernel radius a substep
+  int max_particles = 4000000;
+};
+
+// The whitewater's scale: U (m/s) and T (s) of WhitewaterSettings.
+struct Scene;
+struct WhitewaterScale {
+  double speed = 0, time = 0;
+};
+WhitewaterScale whitewaterScale(const Scene& scene);
+
 struct CameraSettings {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // == look_at: the renderer frames the domain (camera.h)
   Eigen::Vector3d look_at = Eigen::Vector3d::Zero();
@@ -195,6 +224,11 @@ struct RenderSettings {
   Eigen::Vector3d sky_horizon = Eigen::Vector3d(0.78, 0.84, 0.9);
   double exposure = 1.0;
   std::string tank = "edges";  // how the tank is drawn: edges, glass or none
+  // Whitewater (whitewater.enabled): each kind's linear RGB albedo and its size, times whitewater.particle_size.
+  Eigen::Vector3d spray_color = Eigen::Vector3d(0.9, 0.92, 0.95);
+  Eigen::Vector3d foam_color = Eigen::Vector3d(0.95, 0.95, 0.95);
+  Eigen::Vector3d bubble_color = Eigen::Vector3d(0.8, 0.85, 0.9);
+  double spray_size = 1, foam_size = 1.5, bubble_size = 0.8;
 };
 
 struct Scene {
@@ -212,6 +246,7 @@ struct Scene {
   std::vector<ColliderSettings> sinks;  // shapes that remove the particles entering them
   SolverSettings solver;
   OutputSettings output;
+  WhitewaterSettings whitewater;
   SurfaceSettings surface;
   RenderSettings render;
 
@@ -268,12 +303,13 @@ Scene parseScene(const std::string& text, const std::string& where,
 // The scene as JSON text with every key (the resolved scene saved as scene.json in the output folder).
 std::string sceneToJson(const Scene& scene);
 
-// The settings a later stage reads, as dir/<stage>_settings.json ("surface" or "render"), with `extra` (the
+// The settings a later stage reads, as dir/<stage>_settings.json ("surface", "render" or "whitewater"), with `extra` (the
 // stage's own options, a JSON object) added; the file is rewritten only when they change, so that its time says
 // when they last did. Each frame a stage makes is up to date when it is newer than its inputs and this file, so
 // a changed render setting leaves the surfaces up to date, and a changed surface setting the physics.
-//   surface: dimensions, domain, particle_spacing, surface, colliders, bodies
-//   render:  dimensions, domain, particle_spacing, render, colliders, bodies
+//   surface: dimensions, domain, particle_spacing, surface, colliders, bodies (and whitewater where enabled)
+//   render:  dimensions, domain, particle_spacing, render, colliders, bodies (and whitewater where enabled)
+//   whitewater: dimensions, domain, particle_spacing, gravity, solver, whitewater
 fs::path writeStageSettings(const fs::path& dir, const std::string& stage, const Scene& scene,
                             const std::string& extra = "{}");
 

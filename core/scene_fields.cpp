@@ -262,6 +262,43 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.real("fps", s.output.fps, positive("output frames per simulated second (and the video's frame rate)"));
     v.integer("frames", s.output.frames, atLeast(1, "frames to simulate after frame 0", "", 1e7));
   });
+  v.group("whitewater", info("spray, foam and bubbles from the saved frames (docs/whitewater.md); U is the speed "
+                              "of a fall through the tank, T the tank's diagonal over U, S the rest kernel sum"),
+          [&] {
+    WhitewaterSettings& w = s.whitewater;
+    v.integer("enabled", w.enabled, atLeast(0, "1: surge run makes whitewater between sim and surface", "", 1));
+    v.real("trapped_air_min", w.trapped_air_min, atLeast(0, "trapped air: potential 0 below this v_diff / (U S)"));
+    v.real("trapped_air_max", w.trapped_air_max, positive("trapped air: potential 1 above this v_diff / (U S)"));
+    v.real("wave_crest_min", w.wave_crest_min, atLeast(0, "wave crest: potential 0 below this curvature / S"));
+    v.real("wave_crest_max", w.wave_crest_max, positive("wave crest: potential 1 above this curvature / S"));
+    v.real("kinetic_min", w.kinetic_min, atLeast(0, "kinetic energy: potential 0 below this (|v| / U)^2"));
+    v.real("kinetic_max", w.kinetic_max, positive("kinetic energy: potential 1 above this (|v| / U)^2"));
+    v.real("trapped_air_rate", w.trapped_air_rate,
+           atLeast(0, "diffuse particles a fluid particle makes per T at full trapped-air and kinetic potentials"));
+    v.real("wave_crest_rate", w.wave_crest_rate,
+           atLeast(0, "diffuse particles a fluid particle makes per T at full wave-crest and kinetic potentials"));
+    v.real("lifetime_min", w.lifetime_min,
+           atLeast(0, "shortest lifetime drawn, spent while the particle is foam or a bubble (not in the air); 0 means T", "s"));
+    v.real("lifetime_max", w.lifetime_max, atLeast(0, "longest lifetime drawn; 0 means 3 T", "s"));
+    v.real("spray_drag", w.spray_drag,
+           atLeast(0, "air drag rate on spray (terminal fall |g| / drag); 0 means |g| / (2 U)", "1/s"));
+    v.real("bubble_buoyancy", w.bubble_buoyancy, atLeast(0, "a bubble's upward acceleration, in |g|", "", 1000));
+    v.real("bubble_drag", w.bubble_drag,
+           atLeast(0, "rate a bubble's velocity relaxes to the fluid's (terminal rise buoyancy |g| / drag); 0 means "
+                      "a rise of U / 10", "1/s"));
+    v.integer("spray_neighbors", w.spray_neighbors,
+              atLeast(0, "fewer fluid neighbours than this: spray; 0 means a fifth of the rest lattice's", "", 10000));
+    v.integer("bubble_neighbors", w.bubble_neighbors,
+              atLeast(0, "more fluid neighbours than this: a bubble (between: foam); 0 means three fifths of the "
+                         "rest lattice's", "", 10000));
+    v.real("particle_size", w.particle_size, atLeast(0, "radius a diffuse particle is drawn at; 0 means "
+                                                        "particle_spacing / 4", "m"));
+    v.integer("substeps", w.substeps,
+              atLeast(0, "diffuse steps a frame; 0: enough that nothing moves more than a kernel radius in one",
+                      "", 10000));
+    v.integer("max_particles", w.max_particles,
+              atLeast(0, "most diffuse particles at once; generation stops at it", "", 2e9));
+  });
   v.group("surface", info("the surfacer"), [&] {
     v.real("particle_radius", s.surface.particle_radius,
            atLeast(0, "radius of each particle's sphere in the level set; 0 means particle_spacing", "m"));
@@ -326,6 +363,12 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.choice("tank", s.render.tank, {"edges", "glass", "none"},
              info("how the tank is drawn: its edges as thin dark bars, its walls as clear glass (path tracer; the "
                   "preview draws edges), or not at all"));
+    v.vector("spray_color", s.render.spray_color, atLeast(0, "linear RGB albedo of spray", "", 1), true);
+    v.vector("foam_color", s.render.foam_color, atLeast(0, "linear RGB albedo of foam", "", 1), true);
+    v.vector("bubble_color", s.render.bubble_color, atLeast(0, "linear RGB albedo of bubbles", "", 1), true);
+    v.real("spray_size", s.render.spray_size, positive("spray's radius, times whitewater.particle_size"));
+    v.real("foam_size", s.render.foam_size, positive("foam's radius, times whitewater.particle_size"));
+    v.real("bubble_size", s.render.bubble_size, positive("bubbles' radius, times whitewater.particle_size"));
   });
 }
 

@@ -164,7 +164,58 @@ void validateSources(Scene& s, const std::string& where) {
   }
 }
 
+// Lattice sites within the kernel radius of one, itself left out: the rest lattice's neighbour count.
+int restNeighbors(const Scene& s) {
+  const double r = s.solver.kernel_radius / s.particle_spacing;
+  const int reach = int(std::floor(r)), zReach = s.dimensions == 3 ? reach : 0;
+  int count = 0;
+  for (int z = -zReach; z <= zReach; ++z)
+    for (int y = -reach; y <= reach; ++y)
+      for (int x = -reach; x <= reach; ++x)
+        if (x * x + y * y + z * z <= r * r * (1 - 1e-9)) ++count;
+  return count - 1;
+}
+
+void validateWhitewater(Scene& s, const std::string& where) {
+  WhitewaterSettings& w = s.whitewater;
+  if (w.particle_size == 0) w.particle_size = s.particle_spacing / 4;  // the later stages draw any whitewater/
+  if (!w.enabled) return;
+  auto ordered = [&](double lo, double hi, const char* key) {
+    if (!(lo < hi)) throw InputError(where, std::string("whitewater.") + key, "must exceed its _min");
+  };
+  ordered(w.trapped_air_min, w.trapped_air_max, "trapped_air_max");
+  ordered(w.wave_crest_min, w.wave_crest_max, "wave_crest_max");
+  ordered(w.kinetic_min, w.kinetic_max, "kinetic_max");
+  const WhitewaterScale scale = whitewaterScale(s);
+  if (!(scale.speed > 0))
+    throw InputError(where, "whitewater.enabled",
+                     "the scene has neither gravity nor a moving fluid to set the whitewater's scale");
+  const double g = s.gravity.norm();
+  if (w.lifetime_min == 0) w.lifetime_min = scale.time;
+  if (w.lifetime_max == 0) w.lifetime_max = std::max(3 * scale.time, w.lifetime_min);
+  if (w.lifetime_max < w.lifetime_min)
+    throw InputError(where, "whitewater.lifetime_max", "must not be below lifetime_min");
+  if (w.spray_drag == 0) w.spray_drag = g / (2 * scale.speed);
+  if (w.bubble_drag == 0) w.bubble_drag = w.bubble_buoyancy * g / (0.1 * scale.speed);
+  const int rest = restNeighbors(s);
+  if (w.spray_neighbors == 0) w.spray_neighbors = std::max(1, int(std::lround(rest / 5.0)));
+  if (w.bubble_neighbors == 0) w.bubble_neighbors = std::max(w.spray_neighbors, int(std::lround(rest * 0.6)));
+  if (w.bubble_neighbors < w.spray_neighbors)
+    throw InputError(where, "whitewater.bubble_neighbors", "must not be below spray_neighbors");
+}
+
 }  // namespace
+
+WhitewaterScale whitewaterScale(const Scene& s) {
+  // In 2D the z components are zero.
+  const double diagonal = (s.domain.max - s.domain.min).norm();
+  double speed = std::sqrt(2 * s.gravity.norm() * diagonal);
+  if (speed == 0) {
+    for (const FluidBlock& block : s.fluids) speed = std::max(speed, block.velocity.norm());
+    for (const EmitterSettings& emitter : s.emitters) speed = std::max(speed, std::abs(emitter.speed));
+  }
+  return WhitewaterScale{speed, speed > 0 ? diagonal / speed : 0.0};
+}
 
 void validateScene(Scene& s, const std::string& where) {
   // The default output folder is out/<name>: a scene file must not choose where Surge writes.
@@ -210,6 +261,8 @@ void validateScene(Scene& s, const std::string& where) {
   for (int k = 0; k < d; ++k)
     if (std::max(std::abs(s.domain.min[k]), std::abs(s.domain.max[k])) / surface.voxel_size > double(1 << 22))
       throw InputError(where, "surface.voxel_size", "the domain reaches more than 2^22 voxels from the origin");
+
+  validateWhitewater(s, where);
 
   // The simulator's defaults (sim/solver_defaults.cpp), where the program has the simulator.
   if (solverDefaults()) solverDefaults()(s);

@@ -13,17 +13,9 @@
 
 #include <cstdint>
 
-namespace surge {
+#include "core/hash.h"
 
-// A 32-bit integer hash with full avalanche (Chris Wellons' "lowbias32" constants).
-inline uint32_t hashBits(uint32_t x) {
-  x ^= x >> 16;
-  x *= 0x7feb352dU;
-  x ^= x >> 15;
-  x *= 0x846ca68bU;
-  x ^= x >> 16;
-  return x;
-}
+namespace surge {
 
 // Element i of a pseudo-random permutation of 0..length-1 chosen by `seed` (Kensler 2013, listing 3).
 inline uint32_t permuteIndex(uint32_t i, uint32_t length, uint32_t seed) {
@@ -90,7 +82,7 @@ class SampleRandom {
 
  private:
   static constexpr uint32_t kStratifiedPairs = 6;
-  static float toUnit(uint32_t bits) { return float(bits >> 8) * (1.0f / 16777216.0f); }
+  static float toUnit(uint32_t bits) { return unitFromBits(bits); }
 
   uint32_t pixelSeed_, seed_, sample_, samples_;
   uint32_t counter_ = 0, pair_ = 0;

@@ -418,7 +418,8 @@ Rasterizer::~Rasterizer() {
   OSMesaDestroyContext(impl_->context);
 }
 
-Image Rasterizer::drawMesh(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders) {
+Image Rasterizer::drawMesh(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders,
+                           const WhitewaterSpheres& whitewater) {
   Impl& r = *impl_;
   for (size_t t = 0; t < water.triangles.size(); ++t)
     for (uint32_t v : water.triangles[t])
@@ -442,6 +443,30 @@ Image Rasterizer::drawMesh(const TriangleMesh& water, const std::vector<Collider
   });
   r.begin(camera);
   r.drawTriangles(water.positions, colours, water.triangles);
+  if (!whitewater.empty()) {
+    // Each particle a sphere (a disc in front of the 2D slab), diffuse in its albedo under sky and sun.
+    const TriangleMesh sphere = unitSphere();
+    const size_t nv = sphere.positions.size(), nt = sphere.triangles.size(), n = whitewater.spheres.size();
+    std::vector<Vec3> positions(n * nv);
+    std::vector<Rgba> sphereColours(n * nv);
+    std::vector<std::array<uint32_t, 3>> triangles(n * nt);
+    parallelFor(0, n, [&](size_t begin, size_t end) {
+      for (size_t p = begin; p < end; ++p) {
+        const Eigen::Vector4f& s = whitewater.spheres[p];
+        Vec3 centre = s.head<3>();
+        if (flat) centre.z() = float(r.scene.particle_spacing) * 4;  // in front of the slab
+        for (size_t v = 0; v < nv; ++v) {
+          positions[p * nv + v] = centre + s.w() * sphere.positions[v];
+          const Vec3 normal = flat ? Vec3::UnitZ() : Vec3(sphere.normals[v]);
+          sphereColours[p * nv + v] =
+              display(whitewater.albedo[p].cwiseProduct(r.diffuseLight(normal)), r.look.exposure);
+        }
+        for (size_t t = 0; t < nt; ++t)
+          for (int k = 0; k < 3; ++k) triangles[p * nt + t][k] = uint32_t(p * nv + sphere.triangles[t][k]);
+      }
+    });
+    r.drawTriangles(positions, sphereColours, triangles);
+  }
   r.end(camera, colliders);
   return r.finish();
 }

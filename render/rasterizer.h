@@ -13,6 +13,7 @@
 #include "core/scene.h"
 #include "render/colliders.h"
 #include "render/image.h"
+#include "render/whitewater_spheres.h"
 
 namespace surge {
 
@@ -26,7 +27,9 @@ class Rasterizer {
   Rasterizer& operator=(const Rasterizer&) = delete;
 
   // Throws InputError if a triangle names a vertex the mesh does not have.
-  Image drawMesh(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders = {});
+  // With the frame's whitewater as spheres (discs in 2D) in their colours, lit as the colliders are.
+  Image drawMesh(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders = {},
+                 const WhitewaterSpheres& whitewater = {});
   // Spheres of radius particle_spacing / 2 (in 2D flat discs of 0.8 particle_spacing, overlapping).
   Image drawParticles(const ParticleFrame& particles, const std::vector<ColliderMesh>& colliders = {});
 

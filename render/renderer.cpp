@@ -56,7 +56,7 @@ bool differentSurfaces(const SampleFeatures& a, const SampleFeatures& b) {
 
 Image traceImage(RenderWorkspace& workspace, const RayDevice& device, const TriangleMesh& water,
                  const std::vector<ColliderMesh>& colliders, const Scene& scene, int frame,
-                 const Shading& shading, RenderStats* stats) {
+                 const Shading& shading, RenderStats* stats, const WhitewaterSpheres* whitewater = nullptr) {
   const RenderSettings settings = resolvedRenderSettings(scene);
   if (settings.width <= 0 || settings.height <= 0)
     throw InputError(scene.name, "render.width", "the image must be at least 1x1 pixels");
@@ -65,7 +65,7 @@ Image traceImage(RenderWorkspace& workspace, const RayDevice& device, const Tria
   Shading look = shading;
   look.maxDepth = settings.max_depth;
 
-  const RayScene world(device, water, scene, colliders);
+  const RayScene world(device, water, scene, colliders, whitewater);
   const PinholeCamera camera(settings.camera, width, height);
 
   Image image;
@@ -223,9 +223,9 @@ PathTracer::PathTracer() : impl_(std::make_unique<Impl>()) {}
 PathTracer::~PathTracer() = default;
 
 Image PathTracer::render(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders, const Scene& scene,
-                         int frame, RenderStats* stats) {
+                         int frame, RenderStats* stats, const WhitewaterSpheres* whitewater) {
   return traceImage(impl_->workspace, impl_->device, water, colliders, scene, frame, Shading::fromScene(scene),
-                    stats);
+                    stats, whitewater);
 }
 
 Image renderMesh(const TriangleMesh& water, const Scene& scene, int frame, RenderStats* stats) {
@@ -279,6 +279,8 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
       std::vector<fs::path> inputs = colliders.frameFiles(f);
       inputs.push_back(framePath(dir, particles ? "particles" : "surface", f, "ply"));
       inputs.push_back(settings);
+      if (std::error_code error; fs::exists(framePath(dir, "whitewater", f, "ply"), error))
+        inputs.push_back(framePath(dir, "whitewater", f, "ply"));
       return isUpToDate({framePath(dir, "frames", f, "png")}, inputs);
     };
     frames.erase(std::remove_if(frames.begin(), frames.end(), done), frames.end());
@@ -293,7 +295,8 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
       const Image image =
           particles
               ? rasterizer.drawParticles(readParticlePly(framePath(dir, "particles", frame, "ply")), solids)
-              : rasterizer.drawMesh(readMeshPly(framePath(dir, "surface", frame, "ply")), solids);
+              : rasterizer.drawMesh(readMeshPly(framePath(dir, "surface", frame, "ply")), solids,
+                                    whitewaterSpheresAt(dir, frame, scene));
       writePng(framePath(dir, "frames", frame, "png"), image);
       progress.advance();
     }
@@ -312,7 +315,8 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
       for (int frame : frames) {
         Progress::checkInterrupt();
         const TriangleMesh water = readMeshPly(framePath(dir, "surface", frame, "ply"));
-        Image image = tracer.render(water, colliders.atFrame(frame), scene, frame);
+        const WhitewaterSpheres whitewater = whitewaterSpheresAt(dir, frame, scene);
+        Image image = tracer.render(water, colliders.atFrame(frame), scene, frame, nullptr, &whitewater);
         finishWriting();
         writing = std::async(std::launch::async, [path = framePath(dir, "frames", frame, "png"),
                                                   image = std::move(image)] { writePng(path, image); });

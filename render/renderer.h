@@ -14,6 +14,7 @@
 #include "core/scene.h"
 #include "render/colliders.h"
 #include "render/image.h"  // Image, writePng, readPng
+#include "render/whitewater_spheres.h"
 
 namespace surge {
 
@@ -44,8 +45,9 @@ class PathTracer {
   PathTracer& operator=(const PathTracer&) = delete;
 
   // As renderMesh with the colliders, below.
+  // `whitewater`: the frame's spray, foam and bubbles, if any (whitewater_spheres.h).
   Image render(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders, const Scene& scene, int frame,
-               RenderStats* stats = nullptr);
+               RenderStats* stats = nullptr, const WhitewaterSpheres* whitewater = nullptr);
 
  private:
   struct Impl;

@@ -43,7 +43,8 @@ void onEmbreeError(void* user, RTCError code, const char* text) {
 constexpr unsigned kGroundId = 0;
 constexpr unsigned kTankId = 1;
 constexpr unsigned kWaterId = 2;
-constexpr unsigned kFirstColliderId = 3;
+constexpr unsigned kWhitewaterId = 3;
+constexpr unsigned kFirstColliderId = 4;
 
 // Ray masks: every object is seen by camera and reflection rays, but the tank's edges, a guide for the eye
 // rather than a real frame, cast no shadows (their thin noisy shadow lines would only clutter the picture).
@@ -128,6 +129,7 @@ struct RayScene::Impl {
   RTCScene scene = nullptr;
   const TriangleMesh* water = nullptr;
   const std::vector<ColliderMesh>* colliders = nullptr;
+  const WhitewaterSpheres* whitewater = nullptr;
   std::vector<std::vector<std::array<uint32_t, 3>>> colliderTriangles;  // those drawn (trianglesFacing)
   bool smooth = false;
   SurfaceKind tank = SurfaceKind::TankEdge;
@@ -145,7 +147,7 @@ const std::vector<ColliderMesh>& RayScene::noColliders() {
 }
 
 RayScene::RayScene(const RayDevice& device, const TriangleMesh& water, const Scene& scene,
-                   const std::vector<ColliderMesh>& colliders)
+                   const std::vector<ColliderMesh>& colliders, const WhitewaterSpheres* whitewater)
     : impl_(std::make_unique<Impl>()) {
   const size_t vertexCount = water.positions.size();
   for (size_t t = 0; t < water.triangles.size(); ++t)
@@ -211,6 +213,22 @@ RayScene::RayScene(const RayDevice& device, const TriangleMesh& water, const Sce
   if (!water.triangles.empty())
     attachTriangles(dev.device, impl_->scene, kWaterId, kSeen | kCastsShadow, water.positions,
                     water.triangles);
+  if (whitewater && !whitewater->empty()) {
+    // Spray, foam and bubbles as Embree's sphere points: exact spheres, cheaper than meshes or a density volume
+    // (docs/whitewater.md).
+    impl_->whitewater = whitewater;
+    RTCGeometry geometry = rtcNewGeometry(dev.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    auto* points = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                               RTC_FORMAT_FLOAT4, 4 * sizeof(float),
+                                                               whitewater->spheres.size()));
+    if (points)
+      for (size_t i = 0; i < whitewater->spheres.size(); ++i)
+        for (int k = 0; k < 4; ++k) points[4 * i + k] = whitewater->spheres[i][k];
+    rtcSetGeometryMask(geometry, kSeen | kCastsShadow);
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometryByID(impl_->scene, geometry, kWhitewaterId);
+    rtcReleaseGeometry(geometry);
+  }
   impl_->colliders = &colliders;
   const Eigen::Vector3f camera = framedCamera(scene).position.cast<float>();
   for (size_t c = 0; c < colliders.size(); ++c) {
@@ -249,10 +267,12 @@ bool RayScene::intersect(const Ray& ray, float maxDistance, Hit& hit, bool shado
   const unsigned id = query.hit.geomID;
   const ColliderMesh* collider =
       id >= kFirstColliderId ? &(*impl_->colliders)[id - kFirstColliderId] : nullptr;
-  hit.kind = id == kWaterId  ? SurfaceKind::Water
-             : id == kTankId ? impl_->tank
-             : collider      ? SurfaceKind::Collider
-                             : SurfaceKind::Ground;
+  hit.kind = id == kWaterId        ? SurfaceKind::Water
+             : id == kTankId       ? impl_->tank
+             : id == kWhitewaterId ? SurfaceKind::Whitewater
+             : collider            ? SurfaceKind::Collider
+                                   : SurfaceKind::Ground;
+  if (hit.kind == SurfaceKind::Whitewater) hit.albedo = impl_->whitewater->albedo[query.hit.primID];
   hit.distance = query.ray.tfar;
   hit.point = ray.origin + hit.distance * ray.direction;
   Eigen::Vector3f ng(query.hit.Ng_x, query.hit.Ng_y, query.hit.Ng_z);

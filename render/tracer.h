@@ -11,6 +11,7 @@
 #include "core/scene.h"
 #include "render/camera.h"
 #include "render/colliders.h"
+#include "render/whitewater_spheres.h"
 
 namespace surge {
 
@@ -30,7 +31,7 @@ class RayDevice {
   std::unique_ptr<Impl> impl_;
 };
 
-enum class SurfaceKind { Water, Ground, TankEdge, TankGlass, Collider };
+enum class SurfaceKind { Water, Ground, TankEdge, TankGlass, Collider, Whitewater };
 
 struct Hit {
   SurfaceKind kind = SurfaceKind::Ground;
@@ -42,7 +43,7 @@ struct Hit {
   Eigen::Vector3f leavePoint = Eigen::Vector3f::Zero();
   // Where refracted rays start: the point pushed just through the surface.
   Eigen::Vector3f passPoint = Eigen::Vector3f::Zero();
-  Eigen::Vector3f albedo = Eigen::Vector3f::Zero();  // a collider's colour
+  Eigen::Vector3f albedo = Eigen::Vector3f::Zero();  // a collider's or a whitewater particle's colour
 };
 
 class RayScene {
@@ -50,8 +51,9 @@ class RayScene {
   // Keeps references to `water` and `colliders`, which must outlive this object. Of a one-sided collider only
   // the triangles facing the scene's camera are built (trianglesFacing). Throws InputError if a triangle of
   // `water` names a vertex it does not have, RunError if Embree fails.
+  // `whitewater`, when given, must outlive this object too: its spheres are Embree sphere points.
   RayScene(const RayDevice& device, const TriangleMesh& water, const Scene& scene,
-           const std::vector<ColliderMesh>& colliders);
+           const std::vector<ColliderMesh>& colliders, const WhitewaterSpheres* whitewater = nullptr);
   RayScene(const RayDevice& device, const TriangleMesh& water, const Scene& scene);
   ~RayScene();
   RayScene(const RayScene&) = delete;

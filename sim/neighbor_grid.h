@@ -11,6 +11,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -80,6 +81,31 @@ class NeighborGrid {
   // For positions in the order of the last sort(): lists, for each particle, every other particle closer than
   // `radius` (one or two cell sizes), in increasing index order.
   void findNeighbors(const std::vector<Vec<Dim>>& sortedPositions, float radius, NeighborLists& lists);
+
+  // For a point anywhere (a diffuse particle among the fluid's): visit(begin, end) for each run of slots, in the
+  // last sort's order, of the cells within `radius` (one or two cell sizes) of p, a row of cells a run; the
+  // caller filters the run by distance (keepInRange).
+  template <typename Visit>
+  void forEachCandidateRun(const Vec<Dim>& p, float radius, Visit&& visit) const {
+    if (order_.empty()) return;
+    const int64_t reach = static_cast<int64_t>(std::ceil(radius / cellSize_ - 1e-4f));
+    const Cell cell = cellCoordinates(p);
+    Cell lo = cell, hi = cell;
+    for (int k = 0; k < Dim; ++k) {
+      lo[k] = std::max<int64_t>(cell[k] - reach, 0);
+      hi[k] = std::min<int64_t>(cell[k] + reach, resolution_[k] - 1);
+    }
+    const int64_t z0 = Dim == 3 ? lo[Dim - 1] : 0, z1 = Dim == 3 ? hi[Dim - 1] : 0;
+    for (int64_t z = z0; z <= z1; ++z)
+      for (int64_t y = lo[1]; y <= hi[1]; ++y) {
+        Cell first = lo, last = hi;
+        first[1] = last[1] = y;
+        if constexpr (Dim == 3) first[2] = last[2] = z;
+        uint32_t begin = 0, end = 0;
+        slotsOfCells(linearIndex(first), linearIndex(last), begin, end);
+        if (end > begin) visit(begin, end);
+      }
+  }
 
   // Cells of the last sort's box, and whether it used the sparse (sorted keys) path.
   uint64_t cellCount() const { return cellCount_; }

@@ -493,7 +493,8 @@ void writeMeshObj(const fs::path& path, const TriangleMesh& mesh) {
 // surfaceFrame, with the colliders as they stand at this frame: the water meets them (collider_clip.h) and
 // the VDB holds their level sets after the water's grids (planes have none: a half-space has no narrow band).
 SurfaceStats surfaceFrameWith(const ParticleFrame& frame, const Scene& scene, const fs::path& vdbPath,
-                              const fs::path& meshPath, const std::vector<SurfaceCollider>& colliders) {
+                              const fs::path& meshPath, const std::vector<SurfaceCollider>& colliders,
+                              const DiffuseFrame* whitewater = nullptr) {
   const FloatGrid::Ptr grid = buildLevelSet(frame, scene, colliders);
   TriangleMesh mesh = meshLevelSet(*grid, scene.surface.adaptivity);
   if (!colliders.empty()) snapOutOfColliders(mesh, colliders, grid->voxelSize()[0]);
@@ -531,6 +532,10 @@ SurfaceStats surfaceFrameWith(const ParticleFrame& frame, const Scene& scene, co
     extras.pointPositions = &x;
     extras.pointVelocities = &v;
     extras.pointVoxel = 4 * p.spacing;  // about 64 particles per voxel of the points grid
+  }
+  if (whitewater) {
+    extras.whitewater = whitewater;
+    if (!scene.surface.write_points) extras.pointVoxel = 4 * p.spacing;
   }
   for (const SurfaceCollider& c : colliders)
     if (c.output) extras.colliders.push_back(c.output);
@@ -576,6 +581,8 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
                                        framePath(dir, "surface", f, "ply")};
       if (scene.surface.write_obj) outputs.push_back(framePath(dir, "surface", f, "obj"));
       std::vector<fs::path> inputs = {framePath(dir, "particles", f, "ply"), settings};
+      if (std::error_code error; fs::exists(framePath(dir, "whitewater", f, "ply"), error))
+        inputs.push_back(framePath(dir, "whitewater", f, "ply"));
       for (const fs::path& file : colliderFrameFiles(dir, scene, f)) inputs.push_back(file);
       return isUpToDate(outputs, inputs);
     };
@@ -602,9 +609,15 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
             throw InputError(path.string(), "vertex " + std::to_string(far),
                              "lies more than 2^22 voxels (surface.voxel_size) from the origin");
           // Isolated: a frame beside one that fails runs to its end and is written whole (runIsolated).
+          // The frame's whitewater, when the folder has it, goes into the VDB beside the water.
+          const fs::path whitewaterPath = framePath(dir, "whitewater", f, "ply");
+          std::error_code error;
+          const bool whitewater = fs::exists(whitewaterPath, error);
+          const DiffuseFrame diffuse = whitewater ? readDiffusePly(whitewaterPath) : DiffuseFrame{};
           runIsolated([&] {
             surfaceFrameWith(frame, scene, framePath(dir, "surface", f, "vdb"), framePath(dir, "surface", f, "ply"),
-                             colliders.empty() ? std::vector<SurfaceCollider>() : colliders.atFrame(f));
+                             colliders.empty() ? std::vector<SurfaceCollider>() : colliders.atFrame(f),
+                             whitewater ? &diffuse : nullptr);
           });
           const std::lock_guard<std::mutex> lock(advance);
           progress.advance();

@@ -38,25 +38,45 @@ openvdb::Vec3SGrid::Ptr velocityGrid(const BlockField& blocks, const openvdb::ma
   return grid;
 }
 
-// The particles as a PointDataGrid "points" (positions stored relative to their voxel, 16-bit fixed point as
-// Houdini does by default, error under voxel / 2^16) with a float vector attribute "v".
-openvdb::points::PointDataGrid::Ptr pointsGrid(const std::vector<Eigen::Vector3f>& x,
-                                               const std::vector<Eigen::Vector3f>& v, double voxel) {
+// Points as a PointDataGrid `name` (positions stored relative to their voxel, 16-bit fixed point as Houdini does
+// by default, error under voxel / 2^16) with a float vector attribute "v", and for whitewater its id, type and
+// lifetime.
+openvdb::points::PointDataGrid::Ptr pointsGrid(const std::string& name, const std::vector<Eigen::Vector3f>& x,
+                                               const std::vector<Eigen::Vector3f>& v, double voxel,
+                                               const DiffuseFrame* whitewater = nullptr) {
+  const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(voxel);
+  if (x.empty()) {  // no point: an empty grid still names the channel
+    auto grid = openvdb::points::PointDataGrid::create();
+    grid->setTransform(transform);
+    grid->setName(name);
+    return grid;
+  }
   std::vector<openvdb::Vec3R> positions(x.size());
   std::vector<openvdb::Vec3s> velocities(v.size());
   for (size_t i = 0; i < x.size(); ++i) positions[i] = openvdb::Vec3R(x[i].x(), x[i].y(), x[i].z());
   for (size_t i = 0; i < v.size(); ++i) velocities[i] = openvdb::Vec3s(v[i].x(), v[i].y(), v[i].z());
-  const openvdb::math::Transform::Ptr transform = openvdb::math::Transform::createLinearTransform(voxel);
   const openvdb::points::PointAttributeVector<openvdb::Vec3R> positionWrapper(positions);
   const auto index = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(positionWrapper, *transform);
   auto grid = openvdb::points::createPointDataGrid<openvdb::points::FixedPointCodec</*1-byte=*/false>,
                                                    openvdb::points::PointDataGrid>(*index, positionWrapper, *transform);
-  openvdb::points::appendAttribute<openvdb::Vec3s>(grid->tree(), "v");
-  const openvdb::points::PointAttributeVector<openvdb::Vec3s> velocityWrapper(velocities);
-  openvdb::points::populateAttribute<openvdb::points::PointDataTree, openvdb::tools::PointIndexTree,
-                                     openvdb::points::PointAttributeVector<openvdb::Vec3s>>(
-      grid->tree(), index->tree(), "v", velocityWrapper);
-  grid->setName("points");
+  auto add = [&](const char* attribute, const auto& values) {
+    using T = typename std::decay_t<decltype(values)>::value_type;
+    openvdb::points::appendAttribute<T>(grid->tree(), attribute);
+    const openvdb::points::PointAttributeVector<T> wrapper(values);
+    openvdb::points::populateAttribute<openvdb::points::PointDataTree, openvdb::tools::PointIndexTree,
+                                       openvdb::points::PointAttributeVector<T>>(grid->tree(), index->tree(),
+                                                                                 attribute, wrapper);
+  };
+  add("v", velocities);
+  if (whitewater) {
+    const size_t n = whitewater->size();
+    std::vector<int32_t> ids(n), types(n);
+    for (size_t i = 0; i < n; ++i) ids[i] = int32_t(whitewater->id[i]), types[i] = whitewater->type[i];
+    add("id", ids);
+    add("type", types);
+    add("lifetime", whitewater->lifetime);
+  }
+  grid->setName(name);
   return grid;
 }
 
@@ -103,14 +123,11 @@ class SeekableArchive : public openvdb::io::Archive {
 void writeSurfaceVdb(const fs::path& path, const openvdb::FloatGrid::Ptr& surface, const VdbExtras& extras) {
   openvdb::GridCPtrVec grids{surface};
   if (extras.velocity) grids.push_back(velocityGrid(*extras.velocity, surface->transform()));
-  if (extras.pointPositions && !extras.pointPositions->empty())
-    grids.push_back(pointsGrid(*extras.pointPositions, *extras.pointVelocities, extras.pointVoxel));
-  else if (extras.pointPositions) {  // no particle: an empty points grid still names the channel
-    auto grid = openvdb::points::PointDataGrid::create();
-    grid->setTransform(openvdb::math::Transform::createLinearTransform(extras.pointVoxel));
-    grid->setName("points");
-    grids.push_back(grid);
-  }
+  if (extras.pointPositions)
+    grids.push_back(pointsGrid("points", *extras.pointPositions, *extras.pointVelocities, extras.pointVoxel));
+  if (extras.whitewater)
+    grids.push_back(pointsGrid("whitewater", extras.whitewater->position, extras.whitewater->velocity,
+                               std::max(extras.pointVoxel, 1e-6), extras.whitewater));
   grids.insert(grids.end(), extras.colliders.begin(), extras.colliders.end());
 
   // The atomic write is done here, as the UUID is stamped once the file is whole: a temporary name in the same

@@ -1,7 +1,8 @@
 // The VDB file of a surface frame, by Houdini's and Blender's conventions: the level set `surface` (grid class
 // level set), and on request a velocity grid `v` (a vector grid, vector type
 // contravariant-relative, as Houdini writes velocity fields) and the particles as a PointDataGrid `points` with a
-// float vector attribute `v`; after them the colliders' level sets `collider_<name>` (collider_clip.h).
+// float vector attribute `v`; the whitewater as a PointDataGrid `whitewater` with `v`, `id`, `type` (0 spray,
+// 1 foam, 2 bubble) and `lifetime` when the folder has it; after them the colliders' level sets `collider_<name>` (collider_clip.h).
 // Included only by surfacer.cpp (it pulls in OpenVDB's core headers).
 #pragma once
 
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "core/files.h"
+#include "core/ply.h"
 #include "surface/particle_field.h"
 
 namespace surge {
@@ -20,6 +22,8 @@ struct VdbExtras {
   const std::vector<Eigen::Vector3f>* pointPositions = nullptr;
   const std::vector<Eigen::Vector3f>* pointVelocities = nullptr;
   double pointVoxel = 0;  // the points grid's voxel size
+  // The frame's whitewater as a PointDataGrid "whitewater" with v, id, type and lifetime (whitewater/ frames).
+  const DiffuseFrame* whitewater = nullptr;
   std::vector<openvdb::FloatGrid::ConstPtr> colliders;  // written as they are (named), after the others
 };
 

@@ -130,6 +130,16 @@ TEST(Cluster, SlurmDryRunPrintsTheJobsAndWritesNothing) {
        at = dry.out.find("#SBATCH --array=0-2", at + 1))
     ++arrays;
   EXPECT_EQ(arrays, 2u);
+  EXPECT_EQ(dry.out.find("whitewater"), std::string::npos) << "a scene without whitewater got its job";
+
+  // With whitewater, its one job comes between the simulation and the surfaces, which wait for it.
+  const SurgeResult white = runSurge("run '" + scene.string() + "' --slurm --dry-run --chunk 2 --set output.frames=4 " +
+                                     "--set whitewater.enabled=1 --out '" + out.string() + "'");
+  ASSERT_EQ(white.status, 0) << white.err;
+  for (const char* line : {" whitewater ", "--dependency=afterok:<sim job id>",
+                           "--dependency=afterok:<whitewater job id>", "--dependency=aftercorr:<surface job id>"})
+    EXPECT_NE(white.out.find(line), std::string::npos) << "missing: " << line << "\n" << white.out;
+  EXPECT_FALSE(fs::exists(out));
 
   const char* path = std::getenv("PATH");
   const std::string saved = path ? path : "";
