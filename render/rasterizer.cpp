@@ -455,8 +455,10 @@ Image Rasterizer::drawMesh(const TriangleMesh& water, const std::vector<Collider
         const Eigen::Vector4f& s = whitewater.spheres[p];
         Vec3 centre = s.head<3>();
         if (flat) centre.z() = float(r.scene.particle_spacing) * 4;  // in front of the slab
+        // The 2D view shows a whole tank face-on: a disc is at least a spacing across, or it is a pixel.
+        const float radius = flat ? std::max(s.w(), 0.5f * float(r.scene.particle_spacing)) : s.w();
         for (size_t v = 0; v < nv; ++v) {
-          positions[p * nv + v] = centre + s.w() * sphere.positions[v];
+          positions[p * nv + v] = centre + radius * sphere.positions[v];
           const Vec3 normal = flat ? Vec3::UnitZ() : Vec3(sphere.normals[v]);
           sphereColours[p * nv + v] =
               display(whitewater.albedo[p].cwiseProduct(r.diffuseLight(normal)), r.look.exposure);

@@ -27,7 +27,8 @@ class Rasterizer {
   Rasterizer& operator=(const Rasterizer&) = delete;
 
   // Throws InputError if a triangle names a vertex the mesh does not have.
-  // With the frame's whitewater as spheres (discs in 2D) in their colours, lit as the colliders are.
+  // With the frame's whitewater as spheres (discs in 2D, at least a spacing across) in their colours, lit as
+  // the colliders are.
   Image drawMesh(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders = {},
                  const WhitewaterSpheres& whitewater = {});
   // Spheres of radius particle_spacing / 2 (in 2D flat discs of 0.8 particle_spacing, overlapping).
