@@ -72,6 +72,23 @@ WhitewaterStepper::WhitewaterStepper(const Scene& scene)
   tankMin_ = scene.domain.min.cast<float>();
   tankMax_ = scene.domain.max.cast<float>();
   if (scene.dimensions == 2) gravity_.z() = tankMin_.z() = tankMax_.z() = 0;
+  for (size_t c = 0; c < scene.colliders.size(); ++c) colliders_.push_back(buildColliderShape(scene, c));
+}
+
+bool WhitewaterStepper::meetColliders(Eigen::Vector3f& p, Eigen::Vector3f& v, bool spray,
+                                      const std::vector<Pose>& poses) const {
+  for (size_t c = 0; c < colliders_.size(); ++c) {
+    const Pose& pose = poses[c];
+    Eigen::Vector3f normal;
+    const float d = float(pose.scale) *
+                    colliders_[c].distance(pose.toLocal(p.cast<double>()).cast<float>(), normal);
+    if (!(d < 0)) continue;
+    if (spray) return false;
+    const Eigen::Vector3f n = (pose.rotation * normal.cast<double>()).cast<float>();
+    p -= d * n;
+    v -= std::min(0.0f, v.dot(n)) * n;
+  }
+  return true;
 }
 
 void WhitewaterStepper::sortFluid(const std::vector<Eigen::Vector3f>& x, const std::vector<Eigen::Vector3f>& v) {
@@ -273,8 +290,11 @@ void WhitewaterStepper::advance(const ParticleFrame& a, const ParticleFrame& b, 
   std::vector<uint8_t> dead(diffuse.size(), 0);
   std::vector<Eigen::Vector3f> xm(n), vm(n);
   const float buoyancy = float(w.bubble_buoyancy);
+  std::vector<Pose> poses(colliders_.size());
   for (int step = 0; step < substeps; ++step) {
     const float t = (float(step) + 0.5f) / float(substeps);
+    for (size_t c = 0; c < colliders_.size(); ++c)
+      poses[c] = colliderPose(scene_.colliders[c], (double(frame) + double(step + 1) / substeps) * frameTime_);
     parallelFor(0, n, [&](size_t b0, size_t e0) {
       for (size_t i = b0; i < e0; ++i) xm[i] = lerp(a.position[i], xb[i], t), vm[i] = lerp(a.velocity[i], vb[i], t);
     });
@@ -317,6 +337,8 @@ void WhitewaterStepper::advance(const ParticleFrame& a, const ParticleFrame& b, 
               v[axis] = upper ? std::min(v[axis], 0.0f) : std::max(v[axis], 0.0f);
             }
           }
+        // The colliders: spray breaks on them, foam and bubbles are moved out.
+        if (!colliders_.empty() && !meetColliders(x, v, type == kSpray, poses)) dead[k] = 1;
         if (!x.allFinite() || !v.allFinite()) dead[k] = 1;
       }
     });

@@ -11,6 +11,8 @@
 
 #include "core/ply.h"
 #include "core/scene.h"
+#include "geometry/collider_shape.h"
+#include "geometry/pose.h"
 #include "sim/neighbor_grid.h"
 
 namespace surge {
@@ -53,7 +55,12 @@ class WhitewaterStepper {
   template <typename Visit>
   void forEachFluidNear(const Eigen::Vector3f& p, Visit&& visit) const;
 
+  // Moves p out of the colliders as they stand at `time` (their poses), taking the velocity's part into them
+  // away; false if p is spray that met one (it breaks there).
+  bool meetColliders(Eigen::Vector3f& p, Eigen::Vector3f& v, bool spray, const std::vector<Pose>& poses) const;
+
   const Scene& scene_;
+  std::vector<ColliderShape> colliders_;  // the scene's colliders (not its bodies), in their own frames
   const WhitewaterSettings& settings_;
   float h_, restSum_, speed_, timeScale_, frameTime_;
   Eigen::Vector3f gravity_, tankMin_, tankMax_;

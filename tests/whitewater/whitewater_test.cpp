@@ -166,5 +166,31 @@ TEST(Whitewater, FoamOnARigidlyRotatingPoolStaysOnItsCircle) {
   }
 }
 
+// Spray breaks on a collider (without it the same throw flies on); a bubble that finds itself inside one is moved
+// out onto its surface.
+TEST(Whitewater, SprayBreaksOnAColliderAndBubblesStayOutOfIt) {
+  const std::string box = R"(, "colliders": [{"shape": "box", "position": [0.6, 0.5, 0.5], "size": [0.2, 0.2, 0.2]}])";
+  const Scene scene = parseScene(R"({"name": "ww", "dimensions": 3, "domain": {"min": [0, 0, 0], "max": [1, 1, 1]},
+    "particle_spacing": 0.02, "fluids": [{"box": {"min": [0, 0, 0], "max": [0.2, 0.2, 0.2]}}],
+    "output": {"fps": 30, "frames": 10}, "whitewater": {"enabled": 1, "lifetime_min": 100, "lifetime_max": 100}
+    )" + box + "}", "test");
+  const Scene open = whitewaterScene();
+  const ParticleFrame none;
+  for (const Scene* s : {&scene, &open}) {
+    WhitewaterStepper stepper(*s);
+    DiffuseFrame spray = oneParticle({0.3f, 0.5f, 0.5f}, {3, 0, 0}, kSpray);
+    for (int f = 0; f < 4; ++f) stepper.advance(none, none, f, spray);
+    EXPECT_EQ(spray.size(), s == &scene ? 0u : 1u) << (s == &scene ? "through the box" : "without the box");
+  }
+  WhitewaterStepper stepper(scene);
+  const ParticleFrame water = block({0, 0, 0}, {1, 0.8f, 1}, 0.02f);
+  DiffuseFrame bubble = oneParticle({0.62f, 0.45f, 0.5f}, {0, 0, 0}, kBubble);
+  stepper.advance(water, water, 0, bubble);
+  ASSERT_EQ(bubble.size(), 1u);
+  const Eigen::Vector3f p = bubble.position[0];
+  const Eigen::Vector3f inside = (p - Eigen::Vector3f(0.6f, 0.5f, 0.5f)).cwiseAbs();
+  EXPECT_GE(inside.maxCoeff(), 0.1f - 1e-5f) << "the bubble is inside the box at " << p.transpose();
+}
+
 }  // namespace
 }  // namespace surge
