@@ -387,6 +387,13 @@ DiffuseFrame readDiffusePly(const fs::path& path) {
   return frame;
 }
 
+bool readDiffusePlyIfPresent(const fs::path& path, DiffuseFrame& frame) {
+  std::error_code error;
+  if (!fs::exists(path, error)) return false;
+  frame = readDiffusePly(path);
+  return true;
+}
+
 void writeMeshPly(const fs::path& path, const TriangleMesh& mesh) {
   const bool normals = mesh.normals.size() == mesh.positions.size() && !mesh.positions.empty();
   const bool velocities = mesh.velocities.size() == mesh.positions.size() && !mesh.positions.empty();

@@ -58,6 +58,8 @@ struct DiffuseFrame {
 
 void writeDiffusePly(const fs::path& path, const DiffuseFrame& frame);
 DiffuseFrame readDiffusePly(const fs::path& path);
+// The later stages draw whatever whitewater/ holds: false, and `frame` untouched, where the file is absent.
+bool readDiffusePlyIfPresent(const fs::path& path, DiffuseFrame& frame);
 
 void writeMeshPly(const fs::path& path, const TriangleMesh& mesh);
 TriangleMesh readMeshPly(const fs::path& path);

@@ -292,6 +292,9 @@ std::vector<SolverMethodEntry>& solverMethodCatalog();
 
 // Lattice points of one fluid box: counts per axis (1 on unused axes in 2D).
 Eigen::Array3i latticeCounts(const Scene& scene, const Box& box);
+// The distances (m) from a site of the rest lattice (particle_spacing, in the scene's dimensions) to its
+// neighbours closer than solver.kernel_radius, itself left out.
+std::vector<double> restNeighborDistances(const Scene& scene);
 
 // Loads a scene file, applies `overrides` ("key.path=value", from --set) and checks it; derived defaults are
 // resolved. Throws InputError naming the file (or --set) and the key.

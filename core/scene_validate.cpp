@@ -164,18 +164,6 @@ void validateSources(Scene& s, const std::string& where) {
   }
 }
 
-// Lattice sites within the kernel radius of one, itself left out: the rest lattice's neighbour count.
-int restNeighbors(const Scene& s) {
-  const double r = s.solver.kernel_radius / s.particle_spacing;
-  const int reach = int(std::floor(r)), zReach = s.dimensions == 3 ? reach : 0;
-  int count = 0;
-  for (int z = -zReach; z <= zReach; ++z)
-    for (int y = -reach; y <= reach; ++y)
-      for (int x = -reach; x <= reach; ++x)
-        if (x * x + y * y + z * z <= r * r * (1 - 1e-9)) ++count;
-  return count - 1;
-}
-
 void validateWhitewater(Scene& s, const std::string& where) {
   WhitewaterSettings& w = s.whitewater;
   if (w.particle_size == 0) w.particle_size = s.particle_spacing / 4;  // the later stages draw any whitewater/
@@ -197,7 +185,7 @@ void validateWhitewater(Scene& s, const std::string& where) {
     throw InputError(where, "whitewater.lifetime_max", "must not be below lifetime_min");
   if (w.spray_drag == 0) w.spray_drag = g / (2 * scale.speed);
   if (w.bubble_drag == 0) w.bubble_drag = w.bubble_buoyancy * g / (0.1 * scale.speed);
-  const int rest = restNeighbors(s);
+  const int rest = int(restNeighborDistances(s).size());
   if (w.spray_neighbors == 0) w.spray_neighbors = std::max(1, int(std::lround(rest / 5.0)));
   if (w.bubble_neighbors == 0) w.bubble_neighbors = std::max(w.spray_neighbors, int(std::lround(rest * 0.6)));
   if (w.bubble_neighbors < w.spray_neighbors)
@@ -205,6 +193,19 @@ void validateWhitewater(Scene& s, const std::string& where) {
 }
 
 }  // namespace
+
+std::vector<double> restNeighborDistances(const Scene& s) {
+  const double spacing = s.particle_spacing, h = s.solver.kernel_radius;
+  const int reach = int(std::floor(h / spacing)), zReach = s.dimensions == 3 ? reach : 0;
+  std::vector<double> distances;
+  for (int z = -zReach; z <= zReach; ++z)
+    for (int y = -reach; y <= reach; ++y)
+      for (int x = -reach; x <= reach; ++x) {
+        const double r = spacing * std::sqrt(double(x * x + y * y + z * z));
+        if (r > 0 && r < h) distances.push_back(r);
+      }
+  return distances;
+}
 
 WhitewaterScale whitewaterScale(const Scene& s) {
   // In 2D the z components are zero.

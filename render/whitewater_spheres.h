@@ -20,7 +20,7 @@ struct WhitewaterSpheres {
 
 inline WhitewaterSpheres whitewaterSpheres(const DiffuseFrame& frame, const Scene& scene) {
   const RenderSettings& r = scene.render;
-  const double base = scene.whitewater.particle_size > 0 ? scene.whitewater.particle_size : scene.particle_spacing / 4;
+  const double base = scene.whitewater.particle_size;  // resolved by the scene reader
   const float size[3] = {float(base * r.spray_size), float(base * r.foam_size), float(base * r.bubble_size)};
   const Eigen::Vector3f colour[3] = {r.spray_color.cast<float>(), r.foam_color.cast<float>(),
                                      r.bubble_color.cast<float>()};
@@ -28,7 +28,7 @@ inline WhitewaterSpheres whitewaterSpheres(const DiffuseFrame& frame, const Scen
   out.spheres.reserve(frame.size());
   out.albedo.reserve(frame.size());
   for (size_t i = 0; i < frame.size(); ++i) {
-    const int kind = std::min<int>(frame.type[i], kBubble);
+    const int kind = frame.type[i];  // 0, 1 or 2: readDiffusePly checks
     const float radius = size[kind] * (0.6f + 0.8f * unitFromBits(hashBits(frame.id[i] ^ 0x5bd1e995U)));
     out.spheres.emplace_back(frame.position[i].x(), frame.position[i].y(), frame.position[i].z(), radius);
     out.albedo.push_back(colour[kind]);
@@ -38,10 +38,9 @@ inline WhitewaterSpheres whitewaterSpheres(const DiffuseFrame& frame, const Scen
 
 // The frame's whitewater spheres, or none when the folder has no whitewater frame for it.
 inline WhitewaterSpheres whitewaterSpheresAt(const fs::path& dir, int frame, const Scene& scene) {
-  const fs::path path = framePath(dir, "whitewater", frame, "ply");
-  std::error_code error;
-  if (!fs::exists(path, error)) return {};
-  return whitewaterSpheres(readDiffusePly(path), scene);
+  DiffuseFrame diffuse;
+  if (!readDiffusePlyIfPresent(framePath(dir, "whitewater", frame, "ply"), diffuse)) return {};
+  return whitewaterSpheres(diffuse, scene);
 }
 
 }  // namespace surge

@@ -610,10 +610,8 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
                              "lies more than 2^22 voxels (surface.voxel_size) from the origin");
           // Isolated: a frame beside one that fails runs to its end and is written whole (runIsolated).
           // The frame's whitewater, when the folder has it, goes into the VDB beside the water.
-          const fs::path whitewaterPath = framePath(dir, "whitewater", f, "ply");
-          std::error_code error;
-          const bool whitewater = fs::exists(whitewaterPath, error);
-          const DiffuseFrame diffuse = whitewater ? readDiffusePly(whitewaterPath) : DiffuseFrame{};
+          DiffuseFrame diffuse;
+          const bool whitewater = readDiffusePlyIfPresent(framePath(dir, "whitewater", f, "ply"), diffuse);
           runIsolated([&] {
             surfaceFrameWith(frame, scene, framePath(dir, "surface", f, "vdb"), framePath(dir, "surface", f, "ply"),
                              colliders.empty() ? std::vector<SurfaceCollider>() : colliders.atFrame(f),

@@ -54,15 +54,8 @@ WhitewaterStepper::WhitewaterStepper(const Scene& scene)
       grid_((scene.domain.min.cast<float>().array() - 2 * float(scene.solver.kernel_radius)).matrix(),
             (scene.domain.max.cast<float>().array() + 2 * float(scene.solver.kernel_radius)).matrix(),
             NeighborGrid<3>::cellSizeFor(float(scene.solver.kernel_radius))) {
-  const double s = scene.particle_spacing, h = scene.solver.kernel_radius;
-  const int reach = int(std::floor(h / s)), zReach = scene.dimensions == 3 ? reach : 0;
   double sum = 0;
-  for (int z = -zReach; z <= zReach; ++z)
-    for (int y = -reach; y <= reach; ++y)
-      for (int x = -reach; x <= reach; ++x) {
-        const double r = s * std::sqrt(double(x * x + y * y + z * z));
-        if (r > 0 && r < h) sum += 1 - r / h;
-      }
+  for (double r : restNeighborDistances(scene)) sum += 1 - r / scene.solver.kernel_radius;
   restSum_ = float(sum);
   const WhitewaterScale scale = whitewaterScale(scene);
   speed_ = float(scale.speed);

@@ -56,8 +56,8 @@ void whitewaterFrames(const fs::path& dir, const Scene& scene, const FrameRange&
   };
   // The frame to start from: range.first's predecessor, or on resume the last of an up-to-date run of frames.
   int start = range.first;
-  if (resume)
-    while (start <= last && upToDate(start) && (start == 0 || upToDate(start - 1))) ++start;
+  if (resume && (start == 0 || upToDate(start - 1)))
+    while (start <= last && upToDate(start)) ++start;
   if (start > last) return;
   DiffuseFrame diffuse;
   diffuse.dimensions = scene.dimensions;
