@@ -55,6 +55,7 @@ struct SolverSettings {
   double artificial_viscosity = 0.05;    // Monaghan's alpha; 0 turns it off
   double kinematic_viscosity = 0;        // laminar nu (m^2/s); 0 turns it off
   double near_pressure = 0;              // Clavet et al. 2005 near-pressure stiffness; 0 turns it off
+  std::string surface_tension_model = "akinci2013";  // how fluids[i].surface_tension acts (sim/surface_tension.h)
 };
 
 struct AttractorKeyframe {
@@ -100,6 +101,7 @@ struct ColliderSettings {
   double thickness = 0;        // open meshes: shell thickness; 0 means particle_spacing (resolved)
   std::vector<ColliderKeyframe> motion;
   double friction = 0;
+  double adhesion = 0;         // W_adhesion / (2 sigma) of the fluid on it (sim/surface_tension.h); 0 none
   Eigen::Vector3d color = Eigen::Vector3d(0.62, 0.6, 0.56);
   int visible = 1;
 };
@@ -123,6 +125,7 @@ struct FluidBlock {
   Box box;
   ColliderSettings solid = shapeless();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  double surface_tension = 0;  // sigma, N/m (N in 2D); 0 none
 
   bool shaped() const { return !solid.shape.empty(); }
   static ColliderSettings shapeless() {

@@ -88,6 +88,10 @@ void visitSolid(SceneVisitor& v, ColliderSettings& c, bool body) {
     v.real("friction", c.friction,
            atLeast(0, "the fraction of the fluid's sliding velocity along the wall taken away over each 1/30 s of "
                       "contact: 0 free slip, 1 no slip", "", 1));
+  v.real("adhesion", c.adhesion,
+         atLeast(0, "Akinci 2013's adhesion of the fluid to it, as the work of adhesion over the fluid's work of "
+                    "cohesion (Young: cos theta = 2 adhesion - 1; 0.5 wets at 90 degrees, 1 spreads); acts with "
+                    "the fluid's surface_tension; 0 turns it off", "", 1));
   v.vector("color", c.color, atLeast(0, "linear RGB albedo in the renders", "", 1), true);
   v.integer("visible", c.visible, atLeast(0, "0: simulated but not drawn", "", 1));
 }
@@ -186,6 +190,9 @@ void visitScene(Scene& s, SceneVisitor& v) {
         visitBox(v, "box", f.box, "the block, filled with particles at cell centres of the lattice; or give a shape");
         visitShapeKeys(v, f.solid, false);
         v.vector("velocity", f.velocity, info("initial velocity", "m/s"));
+        v.real("surface_tension", f.surface_tension,
+               atLeast(0, "surface tension sigma against air (water 0.0728; N in 2D), by "
+                          "solver.surface_tension_model; 0 turns it off", "N/m"));
       });
   v.vector("gravity", s.gravity, info("gravitational acceleration", "m/s^2"));
   v.group("attractor", info("a point moving along keyframes that pulls (or pushes) particles near it"), [&] {
@@ -251,6 +258,9 @@ void visitScene(Scene& s, SceneVisitor& v) {
            atLeast(0, "WCSPH: a fixed step; 0 chooses each step from the CFL condition and the viscous and "
                       "force limits. DFSPH: the largest step (its CFL step may be shorter); 0 means one frame / "
                       "substeps", "s"));
+    v.choice("surface_tension_model", s.solver.surface_tension_model, {"akinci2013"},
+             info("how fluids[i].surface_tension acts: akinci2013, cohesion and curvature forces (Akinci, Akinci "
+                  "and Teschner 2013) calibrated so that sigma is N/m (docs/surface-tension.md)"));
     FieldInfo cfl = positive("Courant number. WCSPH: dt <= cfl h / (c + |v|max), h = kernel_radius / 2; DFSPH: "
                              "dt <= cfl particle_spacing / |v|max; PBF: dt <= cfl kernel_radius / |v|max");
     cfl.max = 1;

@@ -114,6 +114,11 @@ void validateFluids(Scene& s, const std::string& where) {
       if (b.min[k] < s.domain.min[k] || b.max[k] > s.domain.max[k])
         throw InputError(where, key + ".box", "lies outside the domain");
     }
+    // One fluid a scene for now: its blocks share the surface tension.
+    if (i > 0 && fluid.surface_tension != s.fluids[0].surface_tension)
+      throw InputError(where, key + ".surface_tension",
+                       "differs from fluids[0]'s " + formatNumber(s.fluids[0].surface_tension) +
+                           ": the blocks of a scene are one fluid and share it");
   }
 }
 

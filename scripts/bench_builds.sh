@@ -4,6 +4,7 @@
 # run by run so that the machine's drift falls on both alike. Prints each method's median wall seconds of each
 # build and their ratio new / old.
 #   scripts/bench_builds.sh OLD_SURGE NEW_SURGE [repeats, default 3]
+#   METHODS="pbf dfsph" scripts/bench_builds.sh ...   (a subset of the methods)
 set -euo pipefail
 old="${1:?usage: bench_builds.sh OLD_SURGE NEW_SURGE [repeats]}"
 new="${2:?usage: bench_builds.sh OLD_SURGE NEW_SURGE [repeats]}"
@@ -26,7 +27,7 @@ echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg), $r
 echo
 echo "| method | old (s, median) | new (s, median) | new / old |"
 echo "|---|---|---|---|"
-for method in pbf dfsph wcsph; do
+for method in ${METHODS:-pbf dfsph wcsph}; do
   : >"$work/$method.old" && : >"$work/$method.new"
   for ((r = 0; r < repeats; ++r)); do
     timed "$old" "$method" >>"$work/$method.old"

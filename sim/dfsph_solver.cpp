@@ -55,7 +55,8 @@ void DfsphSolver<Dim>::beginFrame(double) {
 template <int Dim>
 float DfsphSolver<Dim>::stableTimeStep() {
   const float fastest = this->fastestAfterFall(maxStep_);
-  return fastest > 0 ? std::min(maxStep_, cfl_ * spacing_ / fastest) : maxStep_;
+  const float step = fastest > 0 ? std::min(maxStep_, cfl_ * spacing_ / fastest) : maxStep_;
+  return std::min(step, this->tension_.stableStep());
 }
 
 template <int Dim>
@@ -160,6 +161,7 @@ void DfsphSolver<Dim>::applyNonPressureForces(float dt, double time) {
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) external.kick(x_[i], v_[i]);
   });
+  this->kickSurfaceTension(x_, dt);
   if (xsphC_ > 0) {
     std::vector<VecD>& smoothed = vectorScratch_;
     smoothed.resize(size());

@@ -86,6 +86,9 @@ class FluidSolver {
   virtual int lastDivergenceIterations() const { return -1; }
   virtual float maxPressure() const { return NAN; }
   virtual PhaseTimes& phaseTimes() = 0;
+  // The work the method's cohesive forces (surface tension, adhesion) did on the fluid since the last call (J):
+  // surface energy turned into motion, which the energy account counts as a source's work.
+  virtual double takeForceWork() { return 0; }
 
   // The colliders and bodies the fluid meets (empty without them); the bodies' coupling sets their poses.
   virtual Colliders<Dim>& colliders() = 0;

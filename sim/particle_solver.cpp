@@ -22,6 +22,7 @@ ParticleSolver<Dim>::ParticleSolver(const Scene& scene, std::shared_ptr<const Co
       mass_(static_cast<float>(scene.solver.rest_density / lattice.weightSum)),
       gravity_(toVec<Dim>(scene.gravity)),
       attractor_(scene.attractor),
+      tension_(scene, mass_),
       grid_(lattice.walls.domainMin(), lattice.walls.domainMax(),
             NeighborGrid<Dim>::cellSizeFor(static_cast<float>(scene.solver.kernel_radius))),
       walls_(std::move(lattice.walls)),
@@ -139,7 +140,7 @@ template <int Dim>
 size_t ParticleSolver<Dim>::coreMemoryBytes() const {
   size_t bytes = (x_.capacity() + v_.capacity() + vectorScratch_.capacity()) * sizeof(VecD);
   bytes += (id_.capacity() + idScratch_.capacity()) * sizeof(uint32_t) + floatScratch_.capacity() * sizeof(float);
-  return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes();
+  return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes() + tension_.memoryBytes();
 }
 
 template RestLattice<2> sphRestLattice<2>(const Scene&);

@@ -22,6 +22,7 @@
 #include "sim/kernels.h"
 #include "sim/measures.h"
 #include "sim/neighbor_grid.h"
+#include "sim/surface_tension.h"
 #include "sim/tank.h"
 
 namespace surge {
@@ -103,6 +104,7 @@ class ParticleSolver : public FluidSolver<Dim> {
   float particleMass() const final { return mass_; }
   uint32_t particleId(size_t i) const { return id_[i]; }
   PhaseTimes& phaseTimes() final { return times_; }
+  double takeForceWork() final { return tension_.active() ? tension_.takeWork() : 0.0; }
   Colliders<Dim>& colliders() final { return colliders_; }
   const Colliders<Dim>& colliders() const { return colliders_; }
 
@@ -156,10 +158,20 @@ class ParticleSolver : public FluidSolver<Dim> {
   // Bytes held by the shared channels, the grid, the lists and the colliders (capacities).
   size_t coreMemoryBytes() const;
 
+  // Surface tension and adhesion at `at` with the current neighbour lists, as a velocity change over dt
+  // (counted in the forces phase); nothing without them.
+  void kickSurfaceTension(const std::vector<VecD>& at, float dt) {
+    if (!tension_.active()) return;
+    const PhaseTimer timer(times_.forces);
+    tension_.computeAccelerations(at, neighbors_, colliders_, dt);
+    tension_.kick(v_, dt);
+  }
+
   // Parameters, fixed at construction.
   const float restDensity_, mass_;
   const VecD gravity_;
   const Attractor<Dim> attractor_;
+  SurfaceTension<Dim> tension_;  // inactive without surface tension
 
   // The particles (structure of arrays), the grid, the walls and the colliders.
   std::vector<VecD> x_, v_;

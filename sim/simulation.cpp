@@ -19,6 +19,7 @@
 #include "geometry/pose.h"
 #include "sim/attractor.h"
 #include "sim/energy_ledger.h"
+#include "sim/surface_tension.h"
 #include "sim/fluid_solver.h"
 #include "sim/frame_outputs.h"
 #include "sim/rigid_bodies.h"
@@ -161,9 +162,16 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
   FrameRecord record;
   record.particles = &frame;
   const FluidMethod& registered = fluidMethod(scene.solver.method, scene.source);
-  EnergyLedger ledger(Dim, sceneSpeed(scene), registered.steadier ? registered.steadier : "shorter steps",
+  // The ledger's floor is the fluid moving at a hundredth of the scene's speed, or of a spacing a frame where the
+  // scene gives it none (zero gravity, nothing moving): what rounding stirs in a fluid at rest is no gain.
+  const double speed = sceneSpeed(scene);
+  EnergyLedger ledger(Dim, speed > 0 ? speed : scene.particle_spacing * scene.output.fps,
+                      registered.steadier ? registered.steadier : "shorter steps",
                       scene.emitters.empty() || registered.emittersAccounted);
   if (!fresh) ledger.resume(dir / "stats.csv", summary.firstFrame);
+  // What surface tension may release (sim/surface_tension.h); a resumed run counts it again from its first frame.
+  const double surfaceEnergy = sceneSurfaceTension(scene) > 0 ? surfaceEnergyBound(scene, initialParticles(scene)) : 0;
+  double forceWork = 0, forceCredited = 0;
   const Attractor<Dim> attractor(scene.attractor);
   auto writeFrame = [&] {
     record.dam = measureDamBreak(scene, frame);
@@ -253,6 +261,11 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
       record.removed = sources->removed;
       ledger.add(sources->work);
     }
+    // Surface tension's work is surface energy released: credited up to the most the fluid's surface held.
+    forceWork += solver.takeForceWork();
+    const double credit = std::min(forceWork, surfaceEnergy) - forceCredited;
+    ledger.add(credit);
+    forceCredited += credit;
     record.phases = solver.phaseTimes();
     record.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart).count();
     if (!scene.colliders.empty() || bodies) {

@@ -1,4 +1,5 @@
 #include "sim/solver_defaults.h"
+#include "sim/surface_tension.h"
 
 #include <algorithm>
 #include <cmath>
@@ -114,7 +115,9 @@ double sceneSpeed(const Scene& scene) {
     attractor = std::sqrt(std::abs(scene.attractor.strength) * scene.attractor.radius) + moving;
   }
   const double fall = std::sqrt(2 * scene.gravity.head(d).norm() * diagonal);
-  return fluid + bodies + 2 * colliders + attractor + fall;
+  // Surface energy turned into motion: a capillary wave a spacing long moves at about sqrt(2 sigma / (rho_0 dx)).
+  const double capillary = std::sqrt(2 * sceneSurfaceTension(scene) / (scene.solver.rest_density * scene.particle_spacing));
+  return fluid + bodies + 2 * colliders + attractor + fall + capillary;
 }
 
 double runawaySpeed(const Scene& scene) {
@@ -149,7 +152,12 @@ void checkSimulationMemory(const Scene& scene) {
 
 std::vector<std::string> solverNotes(const Scene& scene) {
   const FluidMethod& method = fluidMethod(scene.solver.method, scene.source);
-  return method.notes ? method.notes(scene) : std::vector<std::string>{};
+  std::vector<std::string> notes = method.notes ? method.notes(scene) : std::vector<std::string>{};
+  // Adhesion is a share of the fluid's cohesion (sim/surface_tension.h): without surface tension it does nothing.
+  if (sceneHasAdhesion(scene) && sceneSurfaceTension(scene) == 0)
+    notes.push_back("adhesion is set on a collider or body, but the fluid has no surface_tension: adhesion is a "
+                    "share of the fluid's cohesion and does nothing without it");
+  return notes;
 }
 
 }  // namespace surge

@@ -74,7 +74,7 @@ float WcsphSolver<Dim>::stableTimeStep() {
   float dt = cfl_ * h / (speedOfSound_ + m.speed);
   if (nu_ > 0) dt = std::min(dt, 0.125f * h * h / nu_);
   if (m.acceleration > 0) dt = std::min(dt, 0.25f * std::sqrt(h / m.acceleration));
-  return dt;
+  return std::min(dt, this->tension_.stableStep());
 }
 
 template <int Dim>
@@ -88,6 +88,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     parallelFor(0, size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) v_[i] += (0.5f * dt) * a_[i];
     });
+    if (this->tension_.active()) this->tension_.addWork(v_, dt);  // at the half step's velocities
     if (colliding) colliders_.addWrenches(colliderForces_, 0.5 * dt);
     driftAgainstSolids(x_, v_, dt, mass_, colliders_, walls_);
     if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
@@ -102,6 +103,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     parallelFor(0, size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) v_[i] += dt * a_[i];
     });
+    if (this->tension_.active()) this->tension_.addWork(v_, dt);
     if (colliding) colliders_.addWrenches(colliderForces_, dt);
     driftAgainstSolids(x_, v_, dt, mass_, colliders_, walls_);
     if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
@@ -208,6 +210,11 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
       a_[i] = acceleration;
     }
   });
+  // Surface tension and adhesion (sim/surface_tension.h), their adhesion recorded as forces with the others.
+  if (this->tension_.active()) {
+    this->tension_.computeAccelerations(x_, neighbors_, colliders_, 1.0f);
+    this->tension_.addTo(a_);
+  }
   if (!colliders_.empty()) colliderForces_ = colliders_.takeSlotSums();
 }
 

@@ -4,7 +4,7 @@ at rest or near it, or, fed by an emitter until the end, steady.
   check_scene_end.py SCENE.json RUN_DIR   prints one line of figures; exit 0 when it holds, 1 when not.
 
 Near rest: the particles' RMS speed at the end is under a fifth of the speed of a fall through the tank,
-sqrt(2 g H). A dam break still sloshing at its end reads up to 0.15 of it; the pool that boiled under too long a
+sqrt(2 g H) (without gravity, of a capillary wave a spacing long). A dam break still sloshing at its end reads up to 0.15 of it; the pool that boiled under too long a
 PBF step (issue 32) read 0.6. Steady: over the last second the fluid's kinetic energy stays within a quarter of
 its mean (a pour, a river and a fountain read within 3%); one that diverges or boils climbs.
 """
@@ -23,6 +23,9 @@ rest_density = scene.get("solver", {}).get("rest_density", 1000)
 gravity = math.sqrt(sum(g * g for g in scene.get("gravity", [0, -9.81, 0])[:dims]))
 height = scene["domain"]["max"][1] - scene["domain"]["min"][1]
 fall = math.sqrt(2 * gravity * height)
+# Without gravity, surface tension's speed: a capillary wave a spacing long, sqrt(2 sigma / (rho_0 dx)).
+sigma = max([f.get("surface_tension", 0) for f in scene.get("fluids", [])] or [0])
+fall = max(fall, math.sqrt(2 * sigma / (rest_density * spacing)))
 
 
 def rms(row):

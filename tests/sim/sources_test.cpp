@@ -18,19 +18,11 @@
 #include "core/progress.h"
 #include "sim/simulation.h"
 #include "sim/solver_defaults.h"
+#include "tests/sim/run_scene.h"
 #include "tests/sim/stats_columns.h"
 
 namespace surge {
 namespace {
-
-fs::path runScene(const Scene& scene, const std::string& name, int threads = 2, bool resume = false) {
-  const fs::path dir = fs::path(::testing::TempDir()) / name;
-  if (!resume) fs::remove_all(dir);
-  ThreadLimit limit(threads);
-  Progress quiet;
-  simulate(scene, dir, resume, quiet);
-  return dir;
-}
 
 double sum(const std::vector<double>& v, size_t from, size_t to) {
   return std::accumulate(v.begin() + std::ptrdiff_t(from), v.begin() + std::ptrdiff_t(to), 0.0);

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Surface tension's cost (issue 34): the same scene with and without it, one after the other in this script, at
+# the same step (solver.time_step, the capillary limit), so that the time a step is compared step for step; and
+# the share of the step its pass takes (docs/performance.md).
+#
+#   scripts/bench_surface_tension.sh [SURGE_BINARY] [METHOD] [FRAMES]   (20 frames: PBF's drops gain energy by 0.7 s,
+#   docs/surface-tension.md)
+set -euo pipefail
+surge=${1:-build/apps/surge}
+method=${2:-dfsph}
+frames=${3:-20}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+scene=scenes/droplets_zero_g.json
+common=(--set output.frames="$frames" --set solver.method="$method" --set solver.time_step=0.0014 --set solver.substeps=24 --quiet)
+"$surge" sim "$scene" --out "$work/with" "${common[@]}"
+"$surge" sim "$scene" --out "$work/without" "${common[@]}" --set fluids[0].surface_tension=0 \
+  --set fluids[1].surface_tension=0 --set fluids[2].surface_tension=0
+# ms a step from stats.csv over frames 1..N: the whole step (wall_seconds), and the forces phase (ms_viscosity),
+# which holds the surface tension pass beside XSPH; and the solver's iterations a step.
+perstep() {  # perstep STATS COLUMN (wall_seconds in s, the ms_ columns in ms)
+  awk -F, -v c="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next }
+    $1 > 0 { sum += $col[c]; steps += $col["substeps"] }
+    END { printf "%.3f", (c == "wall_seconds" ? 1000 : 1) * sum / steps }' "$1"
+}
+with=$(perstep "$work/with/stats.csv" wall_seconds) without=$(perstep "$work/without/stats.csv" wall_seconds)
+pass=$(perstep "$work/with/stats.csv" ms_viscosity) xsph=$(perstep "$work/without/stats.csv" ms_viscosity)
+mean() {  # mean STATS COLUMN over frames 1..N (iterations is already a step's mean in each frame)
+  awk -F, -v c="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next } $1 > 0 { sum += $col[c]; n++ }
+    END { printf "%.2f", sum / n }' "$1"
+}
+iw=$(mean "$work/with/stats.csv" iterations) io=$(mean "$work/without/stats.csv" iterations)
+awk -v m="$method" -v w="$with" -v o="$without" -v p="$pass" -v x="$xsph" -v iw="$iw" -v io="$io" 'BEGIN {
+  printf "| method | ms a step with / without | the pass, ms a step | its share of a step | iterations a step with / without |\n"
+  printf "|---|---|---|---|---|\n"
+  printf "| %s | %.2f / %.2f | %.2f | %.0f%% | %.1f / %.1f |\n", m, w, o, p - x, 100 * (p - x) / w, iw, io }'

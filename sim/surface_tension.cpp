@@ -1,0 +1,292 @@
+#include "sim/surface_tension.h"
+
+#include <algorithm>
+#include <unordered_set>
+
+#include "core/parallel.h"
+#include "sim/tank.h"
+
+namespace surge {
+namespace {
+
+constexpr int kAdhesionTableSize = 64;
+
+
+// The lattice offsets o (in spacings) of the sites closer than `support`, o = 0 left out.
+template <int Dim>
+std::vector<Eigen::Vector3i> latticeOffsets(float spacing, float support) {
+  const int reach = static_cast<int>(std::ceil(support / spacing));
+  const int zReach = Dim == 3 ? reach : 0;
+  std::vector<Eigen::Vector3i> offsets;
+  for (int i = -reach; i <= reach; ++i)
+    for (int j = -reach; j <= reach; ++j)
+      for (int k = -zReach; k <= zReach; ++k) {
+        const double r = spacing * std::sqrt(double(i * i + j * j + k * k));
+        if ((i || j || k) && r < support) offsets.emplace_back(i, j, k);
+      }
+  return offsets;
+}
+
+// The particle volume of the rest lattice through the cubic spline: V sum W = 1 at an interior site.
+template <int Dim>
+float latticeVolume(float spacing, const CubicSplineKernel<Dim>& kernel) {
+  double weight = 0, unused = 0;
+  latticeSums<Dim>(
+      spacing, kernel.radius(), [&](const Vec<Dim>& r) { return kernel.value(r.norm()); },
+      [&](const Vec<Dim>& r) -> Vec<Dim> { return kernel.gradientFactor(r.norm()) * r; }, &weight, &unused);
+  return static_cast<float>(1.0 / weight);
+}
+
+// Eq. 2's normalisation, one power of h less in 2D.
+float cohesionNormalisation(int dim, float h) { return static_cast<float>(32.0 / (M_PI * std::pow(double(h), 6 + dim))); }
+
+// C(r) / normalisation of eq. 2.
+float cohesionShape(float r, float h) {
+  if (r <= 0 || r >= h) return 0;
+  const float d = h - r, d3 = d * d * d, r3 = r * r * r;
+  return 2 * r > h ? d3 * r3 : 2 * d3 * r3 - h * h * h * h * h * h / 64;
+}
+
+// A(r) of eq. 7: 0.007 / h^3.25 (-4 r^2 / h + 6 r - 2 h)^(1/4) for h / 2 < r <= h, one power of h less in 2D.
+double adhesionKernel(int dim, double r, double h) {
+  if (2 * r <= h || r > h) return 0;
+  return 0.007 / std::pow(h, dim + 0.25) * std::pow(std::max(-4 * r * r / h + 6 * r - 2 * h, 0.0), 0.25);
+}
+
+}  // namespace
+
+double sceneSurfaceTension(const Scene& scene) {
+  return scene.fluids.empty() ? 0.0 : scene.fluids.front().surface_tension;
+}
+
+bool sceneHasAdhesion(const Scene& scene) {
+  for (const ColliderSettings& c : scene.colliders)
+    if (c.adhesion > 0) return true;
+  for (const BodySettings& b : scene.bodies)
+    if (b.solid.adhesion > 0) return true;
+  return false;
+}
+
+double surfaceEnergyBound(const Scene& scene, const ParticleFrame& initial) {
+  const double sigma = sceneSurfaceTension(scene);
+  if (sigma <= 0) return 0;
+  if (!scene.emitters.empty()) return INFINITY;
+  const double spacing = scene.particle_spacing;
+  const int dim = scene.dimensions;
+  auto cell = [&](const Eigen::Vector3f& p) {
+    Eigen::Vector3i c = Eigen::Vector3i::Zero();
+    for (int k = 0; k < dim; ++k) c[k] = int(std::floor((double(p[k]) - scene.domain.min[k]) / spacing));
+    return c;
+  };
+  auto key = [](const Eigen::Vector3i& c) {
+    return (uint64_t(uint32_t(c[0]) & 0x1fffff) << 42) | (uint64_t(uint32_t(c[1]) & 0x1fffff) << 21) |
+           uint64_t(uint32_t(c[2]) & 0x1fffff);
+  };
+  std::unordered_set<uint64_t> cells;
+  for (const Eigen::Vector3f& p : initial.position) cells.insert(key(cell(p)));
+  size_t faces = 0;
+  for (const Eigen::Vector3f& p : initial.position) {
+    const Eigen::Vector3i c = cell(p);
+    for (int k = 0; k < dim; ++k)
+      for (int side : {-1, 1}) {
+        Eigen::Vector3i beside = c;
+        beside[k] += side;
+        faces += cells.count(key(beside)) == 0;
+      }
+  }
+  return sigma * double(faces) * std::pow(spacing, dim - 1);
+}
+
+template <int Dim>
+SurfaceTension<Dim>::SurfaceTension(const Scene& scene, float mass) {
+  const double sigma = sceneSurfaceTension(scene);
+  if (sigma <= 0) return;
+  const float spacing = static_cast<float>(scene.particle_spacing);
+  spacing_ = spacing;
+  support_ = static_cast<float>(scene.solver.kernel_radius);
+  kernel_ = CubicSplineKernel<Dim>(support_);
+  volume_ = latticeVolume<Dim>(spacing, kernel_);
+  mass_ = mass;
+  restDensity_ = static_cast<float>(scene.solver.rest_density);
+  cohesionScale_ = cohesionNormalisation(Dim, support_);
+  gamma_ = static_cast<float>(sigma / tensionPerGamma(spacing, support_, mass));
+  stableStep_ = static_cast<float>(std::sqrt(scene.solver.rest_density * std::pow(spacing, 3) / (2 * M_PI * sigma)));
+
+  // Adhesion: the flat wall's sum of V A along its normal, tabulated by distance, and each solid's beta.
+  std::vector<double> adhesion;
+  for (const ColliderSettings& c : scene.colliders) adhesion.push_back(c.adhesion);
+  for (const BodySettings& b : scene.bodies) adhesion.push_back(b.solid.adhesion);
+  adhesive_ = std::any_of(adhesion.begin(), adhesion.end(), [](double a) { return a > 0; });
+  if (!adhesive_) return;
+  const int reach = static_cast<int>(std::ceil(support_ / spacing)) + 1;
+  const int zReach = Dim == 3 ? reach : 0;
+  adhesionTable_.assign(kAdhesionTableSize + 1, 0.0f);
+  adhesionScale_ = kAdhesionTableSize / support_;
+  for (int t = 0; t <= kAdhesionTableSize; ++t) {
+    const double d = double(support_) * t / kAdhesionTableSize;
+    double sum = 0;
+    // The wall's sites at d + spacing / 2 + k spacing beyond it, tangentially aligned (as TankWalls's).
+    for (int k = 0; k <= reach; ++k)
+      for (int i = -reach; i <= reach; ++i)
+        for (int j = -zReach; j <= zReach; ++j) {
+          const double normal = d + spacing * (0.5 + k);
+          const double r = std::sqrt(normal * normal + double(spacing) * spacing * (i * i + j * j));
+          sum += volume_ * adhesionKernel(Dim, r, support_) * normal / r;
+        }
+    adhesionTable_[t] = static_cast<float>(sum);
+  }
+  const double workPerBeta = adhesionWorkPerBeta();
+  for (double a : adhesion) beta_.push_back(static_cast<float>(a * 2 * sigma / workPerBeta));
+}
+
+template <int Dim>
+float SurfaceTension<Dim>::cohesion(float r) const {
+  return cohesionScale_ * cohesionShape(r, support_);
+}
+
+template <int Dim>
+float SurfaceTension<Dim>::wallAdhesion(float d) const {
+  const float u = std::max(d, 0.0f) * adhesionScale_;
+  if (!(u < kAdhesionTableSize)) return 0;
+  const int t = static_cast<int>(u);
+  const float f = u - t;
+  return (1 - f) * adhesionTable_[t] + f * adhesionTable_[t + 1];
+}
+
+template <int Dim>
+double SurfaceTension<Dim>::adhesionWorkPerBeta() const {
+  // Layers at d_k = spacing (k + 1/2), one particle a column of area spacing^(d-1) each; pulled to the wall by
+  // m rho_0 wallAdhesion(d) per unit beta. The work per area is sum_k m rho_0 integral_{d_k}^h wallAdhesion.
+  const double spacing = spacing_;
+  const int steps = 4 * kAdhesionTableSize;
+  double work = 0;
+  for (double dk = 0.5 * spacing; dk < support_; dk += spacing) {
+    const double du = (support_ - dk) / steps;
+    double integral = 0;
+    for (int s = 0; s < steps; ++s) integral += du * wallAdhesion(static_cast<float>(dk + (s + 0.5) * du));
+    work += mass_ * restDensity_ * integral;
+  }
+  return work / std::pow(spacing, Dim - 1);
+}
+
+template <int Dim>
+double SurfaceTension<Dim>::tensionPerGamma(float spacing, float support, float mass) {
+  const CubicSplineKernel<Dim> kernel(support);
+  const double volume = latticeVolume<Dim>(spacing, kernel);
+  const double scale = cohesionNormalisation(Dim, support);
+  const std::vector<Eigen::Vector3i> offsets = latticeOffsets<Dim>(spacing, support);
+  const int reach = static_cast<int>(std::ceil(support / spacing));
+  const int layers = 4 * reach + 2;
+  // Each layer's colour and normal (along y, the slab's normal).
+  std::vector<double> colour(layers, volume * kernel.value(0)), normal(layers, 0.0);
+  for (int l = 0; l < layers; ++l)
+    for (const Eigen::Vector3i& o : offsets) {
+      if (l + o[1] < 0 || l + o[1] >= layers) continue;
+      const double r = spacing * o.cast<double>().norm();
+      colour[l] += volume * kernel.value(float(r));
+      normal[l] += support * volume * kernel.gradientFactor(float(r)) * (-spacing * o[1]);  // x_i - x_j = -o
+    }
+  double virial = 0;
+  for (int l = 0; l < layers; ++l)
+    for (const Eigen::Vector3i& o : offsets) {
+      const int m = l + o[1];
+      if (m < 0 || m >= layers) continue;
+      const Eigen::Vector3d r = -double(spacing) * o.cast<double>();
+      const double length = r.norm();
+      const double k = 2 / (colour[l] + colour[m]);
+      Eigen::Vector3d force = -(mass * scale * cohesionShape(float(length), support) / length) * r;
+      force[1] -= normal[l] - normal[m];
+      force *= mass * k;
+      const double tangential = Dim == 3 ? 0.5 * (r[0] * force[0] + r[2] * force[2]) : r[0] * force[0];
+      virial += r[1] * force[1] - tangential;
+    }
+  return virial / (4 * std::pow(double(spacing), Dim - 1));
+}
+
+template <int Dim>
+void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const NeighborLists& neighbors,
+                                               Colliders<Dim>& colliders, float impulseScale) {
+  const size_t n = x.size();
+  accel_.resize(n);
+  if (gamma_ > 0) {
+    colour_.resize(n);
+    normal_.resize(n);
+    const float self = volume_ * kernel_.value(0);
+    parallelFor(0, n, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        float c = self;
+        VecD normal = VecD::Zero();
+        for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
+          const VecD r = x[i] - x[*j];
+          const SphKernelPair k = kernel_.pair(r.norm());
+          c += volume_ * k.value;
+          normal += k.gradientFactor * r;
+        }
+        colour_[i] = c;
+        normal_[i] = (support_ * volume_) * normal;
+      }
+    });
+  }
+  const float tiny = 1e-6f * support_;
+  parallelFor(0, n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      VecD a = VecD::Zero();
+      if (gamma_ > 0)
+        for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
+          const VecD r = x[i] - x[*j];
+          const float length = r.norm();
+          VecD pair = normal_[*j] - normal_[i];  // eq. 4
+          if (length > tiny) pair -= (mass_ * cohesion(length) / length) * r;  // eq. 1
+          a += (2.0f / (colour_[i] + colour_[*j])) * pair;  // eq. 6's K_ij
+        }
+      a *= gamma_;
+      if (adhesive_)
+        colliders.forEachNear(x[i], [&](size_t c, float d, const VecD& wallNormal) {
+          if (beta_[c] <= 0) return;
+          const VecD pull = (-beta_[c] * restDensity_ * wallAdhesion(d)) * wallNormal;  // eq. 7, to the wall
+          a += pull;
+          colliders.addImpulse(i, c, (mass_ * impulseScale) * pull, x[i]);
+        });
+      accel_[i] = a;
+    }
+  });
+}
+
+template <int Dim>
+void SurfaceTension<Dim>::kick(std::vector<VecD>& v, float dt) {
+  work_ += parallelSum<double>(0, v.size(), [&](size_t b, size_t e) {
+    double work = 0;
+    for (size_t i = b; i < e; ++i) {
+      const VecD dv = dt * accel_[i];
+      work += double(accel_[i].dot(v[i] + 0.5f * dv));
+      v[i] += dv;
+    }
+    return work;
+  }) * double(mass_) * dt;
+}
+
+template <int Dim>
+void SurfaceTension<Dim>::addTo(std::vector<VecD>& a) const {
+  parallelFor(0, a.size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) a[i] += accel_[i];
+  });
+}
+
+template <int Dim>
+void SurfaceTension<Dim>::addWork(const std::vector<VecD>& v, float dt) {
+  work_ += parallelSum<double>(0, v.size(), [&](size_t b, size_t e) {
+    double work = 0;
+    for (size_t i = b; i < e; ++i) work += double(accel_[i].dot(v[i]));
+    return work;
+  }) * double(mass_) * dt;
+}
+
+template <int Dim>
+size_t SurfaceTension<Dim>::memoryBytes() const {
+  return (normal_.capacity() + accel_.capacity()) * sizeof(VecD) + colour_.capacity() * sizeof(float);
+}
+
+template class SurfaceTension<2>;
+template class SurfaceTension<3>;
+
+}  // namespace surge
