@@ -118,22 +118,21 @@ SurfaceTension<Dim>::SurfaceTension(const Scene& scene, float mass) {
   for (const BodySettings& b : scene.bodies) adhesion.push_back(b.solid.adhesion);
   adhesive_ = std::any_of(adhesion.begin(), adhesion.end(), [](double a) { return a > 0; });
   if (!adhesive_) return;
+  // The lattice beyond a flat wall (TankWalls::sumBeyond), each site pulling with V A(r) along r.
   const int reach = static_cast<int>(std::ceil(support_ / spacing)) + 1;
-  const int zReach = Dim == 3 ? reach : 0;
   adhesionTable_.assign(kAdhesionTableSize + 1, 0.0f);
   adhesionScale_ = kAdhesionTableSize / support_;
   for (int t = 0; t <= kAdhesionTableSize; ++t) {
-    const double d = double(support_) * t / kAdhesionTableSize;
-    double sum = 0;
-    // The wall's sites at d + spacing / 2 + k spacing beyond it, tangentially aligned (as TankWalls's).
-    for (int k = 0; k <= reach; ++k)
-      for (int i = -reach; i <= reach; ++i)
-        for (int j = -zReach; j <= zReach; ++j) {
-          const double normal = d + spacing * (0.5 + k);
-          const double r = std::sqrt(normal * normal + double(spacing) * spacing * (i * i + j * j));
-          sum += volume_ * adhesionKernel(Dim, r, support_) * normal / r;
-        }
-    adhesionTable_[t] = static_cast<float>(sum);
+    const float d[1] = {support_ * t / kAdhesionTableSize};
+    double pull[3];
+    TankWalls<Dim>::sumBeyond(
+        1, d, spacing, reach, [](const VecD&) { return 0.0f; },
+        [&](const VecD& r) -> VecD {
+          const float length = r.norm();
+          return float(volume_ * adhesionKernel(Dim, length, support_) / length) * r;
+        },
+        pull);
+    adhesionTable_[t] = static_cast<float>(pull[0]);
   }
   const double workPerBeta = adhesionWorkPerBeta();
   for (double a : adhesion) beta_.push_back(static_cast<float>(a * 2 * sigma / workPerBeta));
@@ -208,37 +207,34 @@ void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const
                                                Colliders<Dim>& colliders, float impulseScale) {
   const size_t n = x.size();
   accel_.resize(n);
-  if (gamma_ > 0) {
-    colour_.resize(n);
-    normal_.resize(n);
-    const float self = volume_ * kernel_.value(0);
-    parallelFor(0, n, [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) {
-        float c = self;
-        VecD normal = VecD::Zero();
-        for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
-          const VecD r = x[i] - x[*j];
-          const SphKernelPair k = kernel_.pair(r.norm());
-          c += volume_ * k.value;
-          normal += k.gradientFactor * r;
-        }
-        colour_[i] = c;
-        normal_[i] = (support_ * volume_) * normal;
+  colour_.resize(n);
+  normal_.resize(n);
+  const float self = volume_ * kernel_.value(0);
+  parallelFor(0, n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      float c = self;
+      VecD normal = VecD::Zero();
+      for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
+        const VecD r = x[i] - x[*j];
+        const SphKernelPair k = kernel_.pair(r.norm());
+        c += volume_ * k.value;
+        normal += k.gradientFactor * r;
       }
-    });
-  }
+      colour_[i] = c;
+      normal_[i] = (support_ * volume_) * normal;
+    }
+  });
   const float tiny = 1e-6f * support_;
   parallelFor(0, n, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       VecD a = VecD::Zero();
-      if (gamma_ > 0)
-        for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
-          const VecD r = x[i] - x[*j];
-          const float length = r.norm();
-          VecD pair = normal_[*j] - normal_[i];  // eq. 4
-          if (length > tiny) pair -= (mass_ * cohesion(length) / length) * r;  // eq. 1
-          a += (2.0f / (colour_[i] + colour_[*j])) * pair;  // eq. 6's K_ij
-        }
+      for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
+        const VecD r = x[i] - x[*j];
+        const float length = r.norm();
+        VecD pair = normal_[*j] - normal_[i];  // eq. 4
+        if (length > tiny) pair -= (mass_ * cohesion(length) / length) * r;  // eq. 1
+        a += (2.0f / (colour_[i] + colour_[*j])) * pair;  // eq. 6's K_ij
+      }
       a *= gamma_;
       if (adhesive_)
         colliders.forEachNear(x[i], [&](size_t c, float d, const VecD& wallNormal) {

@@ -45,7 +45,8 @@ class SurfaceTension {
   // `mass`: the method's particle mass.
   SurfaceTension(const Scene& scene, float mass);
 
-  bool active() const { return gamma_ > 0 || adhesive_; }
+  // Adhesion comes with surface tension only (it is a share of the fluid's cohesion).
+  bool active() const { return gamma_ > 0; }
   float gamma() const { return gamma_; }
   // The capillary step limit (Brackbill, Kothe and Zemach 1992): dt <= sqrt(rho_0 spacing^3 / (2 pi sigma));
   // infinity without surface tension.

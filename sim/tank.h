@@ -313,7 +313,6 @@ class TankWalls {
     return (p.array() >= domainMin_.array()).all() && (p.array() <= domainMax_.array()).all();
   }
 
- private:
   // Over the lattice beyond `walls` walls whose normals are axes 0 .. walls-1, at distances d[a] from the
   // particle (layers d[a] + spacing / 2 + i spacing, i >= 0, on those axes; every tangential offset within
   // `reach` on the others): returns the sum of weight(r) and writes the sum of gradient(r) to g, and, if asked,
@@ -353,6 +352,8 @@ class TankWalls {
     }
     return w;
   }
+
+ private:
 
   // Calls face(k, side, d) for each wall (axis k, side 0 at domainMin, 1 at domainMax) at distance d from p,
   // then edge(axes, sides, d) for each pair of walls on distinct axes, in the order add() has always summed

@@ -210,7 +210,7 @@ TEST(SurfaceTension, SameBytesAtAnyThreadCountAndAfterAResume) {
 // Adhesion a = W_adhesion / (2 sigma) (sim/surface_tension.h): a cube of water (12^3 particles) set on a plate in
 // zero gravity settles to Young's angle, cos theta = 2a - 1, read from the spherical cap's height h and contact
 // radius r as theta = 2 atan(h / r). Half a spacing on each of h and r (about 9 spacings) moves that angle by up
-// to 6 degrees; the bound is 10. Measured: 116.8, 84.3, 62.7 against 120, 90, 60 (docs/surface-tension.md).
+// to 6 degrees; the bound is 10. Measured: 117.2, 86.0, 62.7 against 120, 90, 60 (docs/surface-tension.md).
 TEST(SurfaceTension, ADropOnAPlateSettlesAtYoungsAngle) {
   for (double adhesion : {0.25, 0.5, 0.75}) {
     SCOPED_TRACE("adhesion " + std::to_string(adhesion));
