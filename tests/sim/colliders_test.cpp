@@ -294,11 +294,13 @@ TEST(Colliders, ThinPlateHoldsAFastColumn) {
 // Rest against a shape: a pool 20 spacings deep with the collider in it settles for 2 s; then, over 1 s:
 //  - the motion and the average density error are no worse than the same pool's without the collider (PBF at
 //    its default 4 substeps x 4 iterations leaves a 20-deep pool about 4% compressed and trembling at an RMS
-//    speed of about 0.023 m/s; the collider must not add to that): the RMS speed within twice the pool's (a
+//    speed of about 0.03 m/s; the collider must not add to that): the RMS speed within twice the pool's (a
 //    pool's tremble differs from one shape of it to another by up to half: measured 0.87 to 1.48 times), the
 //    error within 0.5% more. The fastest single particle, at the contact line where the free surface meets
-//    the collider, within 3 times the pool's own fastest (measured 1.1 to 2.2 times). A collider that pumps
-//    energy shows in ImpactOnAPlaneIsAnImpactOnTheFloor below;
+//    the collider, within 3 times the pool's own fastest. The pool's fastest is the most of four runs whose
+//    gravity differs in its fifth digit: one run's is a single particle's luck (0.14 to 0.69 m/s over 16 such
+//    runs, in two builds), the most of four 0.33 to 0.69. A collider that pumps energy shows in
+//    ImpactOnAPlaneIsAnImpactOnTheFloor below;
 //  - no particle is inside the collider (closer than 0.95 radii);
 //  - the fluid touching the collider has the interior's number density, neither a gap nor a pile: the particles
 //    within 3 spacings of the surface against the count the lattice puts in that band (its area, measured on a
@@ -334,12 +336,23 @@ PoolMotion settleAndWatch(Solver& solver, const Scene& scene) {
 const char* kPool2d = R"({"min": [0, 0], "max": [1, 0.6]})";
 const char* kPoolWater2d = R"([{"box": {"min": [0, 0], "max": [1, 0.4]}}])";
 
+// The pool without colliders over four runs: the most of their fastest, the RMS speed and error of them all.
 const PoolMotion& poolWithoutColliders() {
   static const PoolMotion motion = [] {
-    const Scene scene = makeScene(2, kPool2d, kPoolWater2d, "[]", 0.02);
-    PbfSolver<2> solver(scene);
-    solver.setParticles(initialParticles(scene));
-    return settleAndWatch(solver, scene);
+    PoolMotion pooled;
+    constexpr int kRuns = 4;
+    for (int run = 0; run < kRuns; ++run) {
+      const Scene scene =
+          makeScene(2, kPool2d, kPoolWater2d, "[]", 0.02, {"gravity=[0,-9.81" + std::to_string(run) + "]"});
+      PbfSolver<2> solver(scene);
+      solver.setParticles(initialParticles(scene));
+      const PoolMotion one = settleAndWatch(solver, scene);
+      pooled.fastest = std::max(pooled.fastest, one.fastest);
+      pooled.rmsSpeed += one.rmsSpeed * one.rmsSpeed / kRuns;
+      pooled.densityError += one.densityError / kRuns;
+    }
+    pooled.rmsSpeed = std::sqrt(pooled.rmsSpeed);
+    return pooled;
   }();
   return motion;
 }

@@ -117,38 +117,43 @@ const char* kColumn2d = R"({"name": "column", "dimensions": 2,
   "domain": {"min": [0, 0], "max": [0.4, 1.0]}, "particle_spacing": 0.02,
   "fluids": [{"box": {"min": [0, 0], "max": [0.4, 0.4]}}], "output": {"fps": 30, "frames": 90}})";
 
-// The mean height of the particles that started in the top layer (tracked by id, so a single droplet that
-// hops does not count as the surface moving).
-float topLayerHeight(const PbfSolver<2>& solver, const std::vector<uint32_t>& topIds) {
+// The height of the free surface: the mean over the tank's spacing-wide columns of the highest particle in each.
+// (Not the particles that started on top, by id: at rest they trade places with the layer below, one sinking a
+// spacing while its neighbours stay, and over a second their mean height moved 0.0001 to 0.0024 m between runs
+// whose gravity differed in its fifth digit, while the surface itself moved under 0.0005 m in every one.)
+float surfaceHeight(const PbfSolver<2>& solver, float width, float spacing) {
   ParticleFrame frame;
   solver.getParticles(frame);
-  std::vector<float> heightOfId(frame.size());
-  for (size_t i = 0; i < frame.size(); ++i) heightOfId[frame.id[i]] = frame.position[i].y();
+  std::vector<float> highest(size_t(std::lround(width / spacing)), -INFINITY);
+  for (const auto& p : frame.position) {
+    const size_t column = std::min(highest.size() - 1, size_t(std::max(0.0f, p.x() / spacing)));
+    highest[column] = std::max(highest[column], p.y());
+  }
   double sum = 0;
-  for (uint32_t id : topIds) sum += heightOfId[id];
-  return static_cast<float>(sum / topIds.size());
+  for (float y : highest) sum += y;
+  return static_cast<float>(sum / highest.size());
 }
 
 TEST(PbfSolver, ColumnAtRestStaysAtRest) {
   // A 2D column 20 particles deep on the floor, default solver settings (4 substeps, 4 iterations). In its
   // first frames it settles: the top layer, under-dense with nothing above it, sinks into the one below, and
-  // the Jacobi iterations leave the column a little compressed under its weight; the top layer sinks about a
-  // spacing over the first 2 s (measured: 0.39 -> 0.367 m, then within 0.0005 m). Once settled it must stay at
-  // rest: over the next second its top surface moves less than a tenth of the spacing.
+  // the Jacobi iterations leave the column a little compressed under its weight; its surface sinks about a
+  // spacing over the first 2 s (measured: 0.39 -> 0.371 m, then within 0.0007 m to 6 s). Once settled it must
+  // stay at rest: over the next second its top surface moves less than a tenth of the spacing.
   const Scene scene = parseScene(kColumn2d, "test");
   PbfSolver<2> solver(scene);
-  const ParticleFrame initial = initialParticles(scene);
-  std::vector<uint32_t> topIds;
-  for (size_t i = 0; i < initial.size(); ++i)
-    if (initial.position[i].y() > 0.4f - 0.02f) topIds.push_back(initial.id[i]);
-  ASSERT_EQ(topIds.size(), 20u);
-  solver.setParticles(initial);
+  solver.setParticles(initialParticles(scene));
   const float dt = 1.0f / (30 * 4);
   for (int s = 0; s < 2 * 30 * 4; ++s) ASSERT_EQ(solver.step(dt), -1);
-  const float settled = topLayerHeight(solver, topIds);
+  const float settled = surfaceHeight(solver, 0.4f, 0.02f);
   EXPECT_GT(settled, 0.39f - 0.02f * 2) << "the column collapsed by more than two spacings while settling";
-  for (int s = 0; s < 30 * 4; ++s) ASSERT_EQ(solver.step(dt), -1);
-  EXPECT_LT(std::abs(topLayerHeight(solver, topIds) - settled), 0.1f * 0.02f);
+  float farthest = 0;
+  for (int s = 0; s < 30 * 4; ++s) {
+    ASSERT_EQ(solver.step(dt), -1);
+    farthest = std::max(farthest, std::abs(surfaceHeight(solver, 0.4f, 0.02f) - settled));
+  }
+  std::printf("column: surface %.4f m at 2 s, moving at most %.4f m over the next second\n", settled, farthest);
+  EXPECT_LT(farthest, 0.1f * 0.02f);
 }
 
 // The Chebyshev acceleration runs only when the iterations go to a density error with a cap of at least 8: at a
@@ -198,7 +203,10 @@ TEST(PbfSolver, DeepPoolStaysAtRestAtTheDefaultSubsteps) {
 // a frame and 8 iterations, boiled at them (about 650 J/m of kinetic energy within a second: 1.5 m/s RMS,
 // particles filling the tank). Its depth needs 13 (dt <= 0.9 spacing / sqrt(g H)); the steps are now shortened
 // to them and it stays at rest, under 5 cm/s RMS as the pool at its default steps above. Given 16, which meet the
-// need, every frame takes exactly 16: the frame loop's fixed steps, the bytes they gave before.
+// need, every frame takes exactly 16: the frame loop's fixed steps, the bytes they gave before. Given 8, a frame
+// may take more than 13 where a particle at the surface briefly goes fast enough for the CFL limit to ask for
+// them (one frame in 30 took 14 in one build, none in another, their sums rounded differently): no frame takes
+// fewer than the depth needs, and most take just that.
 TEST(PbfSolver, AStepThePoolCannotBearIsShortened) {
   for (int substeps : {8, 16}) {
     const Scene scene = sceneFrom(R"({"name": "pool", "dimensions": 2, "domain": {"min": [0, 0], "max": [1, 0.6]},
@@ -216,8 +224,13 @@ TEST(PbfSolver, AStepThePoolCannotBearIsShortened) {
     std::printf("pool given %d steps a frame: took %.0f to %.0f, RMS speed after 1 s %.4f m/s\n", substeps, *fewest,
                 *most, rms);
     EXPECT_LT(rms, 0.05) << substeps;
-    EXPECT_EQ(*fewest, substeps == 8 ? 13 : 16);
-    EXPECT_EQ(*most, substeps == 8 ? 13 : 16);
+    const double needed = substeps == 8 ? 13 : 16;
+    EXPECT_EQ(*fewest, needed);
+    if (substeps == 16) {
+      EXPECT_EQ(*most, 16);
+    }
+    const auto exactly = std::count(stats.at("substeps").begin() + 1, stats.at("substeps").end(), needed);
+    EXPECT_GE(exactly, 27) << "frames of 30 taking the " << needed << " steps the depth needs";
   }
 }
 
