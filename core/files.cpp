@@ -42,6 +42,10 @@ void writeFileAtomically(const fs::path& path, const std::function<void(std::ost
   }
 }
 
+fs::path fluidMeshPath(const fs::path& meshPath, const std::string& name) {
+  return meshPath.parent_path().parent_path() / ("surface_" + name) / meshPath.filename();
+}
+
 fs::path framePath(const fs::path& dir, const std::string& sub, int frame, const std::string& ext) {
   char name[64];
   std::snprintf(name, sizeof name, "frame_%05d.%s", frame, ext.c_str());

@@ -27,6 +27,9 @@ std::string formatBytes(double bytes);
 
 // dir/sub/frame_NNNNN.ext: five digits, more for frames above 99,999 (output.frames reaches 10^7).
 fs::path framePath(const fs::path& dir, const std::string& sub, int frame, const std::string& ext);
+// The mesh of fluid `name` beside a frame's first mesh in a scene of several fluids: dir/surface_<name>/frame_NNNNN.ply
+// beside dir/surface/frame_NNNNN.ply.
+fs::path fluidMeshPath(const fs::path& meshPath, const std::string& name);
 
 // The frame numbers of the dir/sub/frame_NNNNN.ext files present (any number of digits framePath writes), sorted.
 std::vector<int> listFrames(const fs::path& dir, const std::string& sub, const std::string& ext);

@@ -287,16 +287,18 @@ void writeParticlePly(const fs::path& path, const ParticleFrame& frame) {
         << "element vertex " << frame.size() << "\n"
         << "property float x\nproperty float y\nproperty float z\n"
         << "property float vx\nproperty float vy\nproperty float vz\n"
-        << "property uint id\nend_header\n";
+        << "property uint id\n" << (frame.fluid.empty() ? "" : "property uchar fluid\n") << "end_header\n";
+    const size_t record = frame.fluid.empty() ? 28 : 29;
     std::string buffer;
-    buffer.resize(frame.size() * 28);
+    buffer.resize(frame.size() * record);
     char* p = buffer.data();
     for (size_t i = 0; i < frame.size(); ++i) {
       const float values[6] = {frame.position[i].x(), frame.position[i].y(), frame.position[i].z(),
                                frame.velocity[i].x(), frame.velocity[i].y(), frame.velocity[i].z()};
       std::memcpy(p, values, sizeof values);
       std::memcpy(p + 24, &frame.id[i], 4);
-      p += 28;
+      if (record == 29) p[28] = static_cast<char>(frame.fluid[i]);
+      p += record;
     }
     out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
   });
@@ -307,8 +309,8 @@ ParticleFrame readParticlePly(const fs::path& path) {
   const PlyFile file = parsePly(path);
   size_t index = 0;
   if (!findElement(file, "vertex", &index)) throw InputError(where, "element vertex", "missing");
-  const auto columns = readColumns(file, index, {"x", "y", "z", "vx", "vy", "vz", "id"},
-                                   {false, false, false, false, false, false, true}, where);
+  const auto columns = readColumns(file, index, {"x", "y", "z", "vx", "vy", "vz", "id", "fluid"},
+                                   {false, false, false, false, false, false, true, true}, where);
   ParticleFrame frame;
   for (const std::string& comment : file.comments)
     if (comment.rfind("dimensions ", 0) == 0) {
@@ -327,6 +329,14 @@ ParticleFrame readParticlePly(const fs::path& path) {
     frame.position[i] = Eigen::Vector3f(float(columns[0][i]), float(columns[1][i]), float(columns[2][i]));
     frame.velocity[i] = Eigen::Vector3f(float(columns[3][i]), float(columns[4][i]), float(columns[5][i]));
     frame.id[i] = columns[6].empty() ? static_cast<uint32_t>(i) : static_cast<uint32_t>(columns[6][i]);
+  }
+  if (!columns[7].empty()) {
+    frame.fluid.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      if (!(columns[7][i] >= 0 && columns[7][i] < 256))
+        throw InputError(where, "vertex " + std::to_string(i) + " fluid", "not a fluid index 0-255");
+      frame.fluid[i] = static_cast<uint8_t>(columns[7][i]);
+    }
   }
   return frame;
 }

@@ -21,12 +21,15 @@ struct ParticleFrame {
   std::vector<Eigen::Vector3f> position;
   std::vector<Eigen::Vector3f> velocity;
   std::vector<uint32_t> id;  // stable particle identity, kept across reordering
+  // Each particle's fluid (Scene::fluidOf) in a scene of several fluids; empty in a scene of one.
+  std::vector<uint8_t> fluid;
 
   size_t size() const { return position.size(); }
   void resize(size_t n) {
     position.resize(n);
     velocity.resize(n);
     id.resize(n);
+    if (!fluid.empty()) fluid.resize(n);
   }
 };
 

@@ -126,6 +126,10 @@ struct FluidBlock {
   ColliderSettings solid = shapeless();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   double surface_tension = 0;  // sigma, N/m (N in 2D); 0 none
+  // The fluid it is (blocks of one name are one fluid). Empty in the file: "water" (resolved).
+  std::string name;
+  double rest_density = 0;  // kg/m^3 (kg/m^2 in 2D); 0 in the file: solver.rest_density (resolved)
+  Eigen::Vector3d color = Eigen::Vector3d::Zero();  // the render's water colour; zero: render.water_color (resolved)
 
   bool shaped() const { return !solid.shape.empty(); }
   static ColliderSettings shapeless() {
@@ -259,6 +263,15 @@ struct Scene {
   // Particles the fluid boxes hold on the lattice of particle_spacing (shaped fluids not counted: the simulator
   // fills them, initialParticles in sim/simulation.h).
   size_t particleCount() const;
+  // The fluid of block i: the index of the first block of its name (a particle frame's `fluid` property).
+  size_t fluidOf(size_t block) const;
+  // True when the blocks name more than one fluid: the particles then carry their fluid.
+  bool severalFluids() const;
+  // The first block of every fluid after the first, in order (none in a scene of one fluid).
+  std::vector<size_t> laterFluids() const;
+  // The rest density of the particles that are not told apart: the first block's, or solver.rest_density
+  // without blocks (emitters bring fluid 0).
+  double referenceDensity() const { return fluids.empty() ? solver.rest_density : fluids.front().rest_density; }
   // True when fluid can enter or leave: emitters, sinks or open faces.
   bool hasSources() const { return !emitters.empty() || !sinks.empty() || !open.empty(); }
   // True when domain.open names the tank's face on `axis` (0 x, 1 y, 2 z), its upper side or its lower.

@@ -193,6 +193,16 @@ void visitScene(Scene& s, SceneVisitor& v) {
         v.real("surface_tension", f.surface_tension,
                atLeast(0, "surface tension sigma against air (water 0.0728; N in 2D), by "
                           "solver.surface_tension_model; 0 turns it off", "N/m"));
+        v.text("name", f.name,
+               info("the fluid it is: blocks of one name are one fluid, and a scene of several fluids writes "
+                    "each particle's in its frames (`fluid`, the index of the fluid's first block) and a surface "
+                    "for each (surface_<name> after the first); empty: water"));
+        v.real("rest_density", f.rest_density,
+               positive("that fluid's rest density (oil about 900, water 1000); not given: solver.rest_density",
+                        "kg/m^3"));
+        v.vector("color", f.color,
+                 atLeast(0.001, "that fluid's colour in the render, as render.water_color (not given: that)", "", 1),
+                 true);
       });
   v.vector("gravity", s.gravity, info("gravitational acceleration", "m/s^2"));
   v.group("attractor", info("a point moving along keyframes that pulls (or pushes) particles near it"), [&] {

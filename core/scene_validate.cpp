@@ -3,6 +3,7 @@
 // (kernel radius, surface radius and voxel), and the simulator's, through solverDefaults(). The camera that frames
 // the domain is the renderer's (render/camera.h, framedCamera).
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <set>
 
@@ -94,9 +95,35 @@ void validateSolids(Scene& s, const std::string& where) {
 // Fluid blocks: a box inside the tank, or a shape of the bodies' vocabulary (geometry/ checks its file and that
 // it lies in the tank).
 void validateFluids(Scene& s, const std::string& where) {
+  constexpr size_t kMostFluids = 255;  // a particle frame's `fluid` is a byte
   for (size_t i = 0; i < s.fluids.size(); ++i) {
     FluidBlock& fluid = s.fluids[i];
     const std::string key = "fluids[" + std::to_string(i) + "]";
+    // Which fluid: a name that can end a grid's name (surface_<name>), and one density and colour a name.
+    if (fluid.name.empty()) fluid.name = "water";
+    if (!std::all_of(fluid.name.begin(), fluid.name.end(), [](char c) { return std::isalnum(uint8_t(c)) || c == '_' || c == '-'; }))
+      throw InputError(where, key + ".name", "'" + fluid.name + "' may hold only letters, digits, _ and -");
+    if (fluid.rest_density == 0) fluid.rest_density = s.solver.rest_density;
+    if (fluid.color == Eigen::Vector3d::Zero()) fluid.color = s.render.water_color;
+    if (i >= kMostFluids) throw InputError(where, key, "a scene holds at most 255 fluid blocks");
+    const FluidBlock& first = s.fluids[s.fluidOf(i)];
+    if (fluid.rest_density != first.rest_density)
+      throw InputError(where, key + ".rest_density",
+                       formatNumber(fluid.rest_density) + " differs from fluids[" + std::to_string(s.fluidOf(i)) +
+                           "]'s " + formatNumber(first.rest_density) + ", a block of the same fluid '" + fluid.name +
+                           "': give it another name");
+    if (fluid.color != first.color)
+      throw InputError(where, key + ".color",
+                       "differs from fluids[" + std::to_string(s.fluidOf(i)) + "]'s, a block of the same fluid '" +
+                           fluid.name + "': give it another name");
+    if (fluid.name != s.fluids[0].name && i == s.fluidOf(i)) {  // the scene's second fluid, or a later one
+      if (s.solver.method != "pbf")
+        throw InputError(where, key + ".name",
+                         "a second fluid ('" + fluid.name + "') runs with solver.method pbf only, so far (not " +
+                             s.solver.method + ")");
+      if (fluid.surface_tension > 0 || s.fluids[0].surface_tension > 0)
+        throw InputError(where, key + ".surface_tension", "surface tension with several fluids is not built yet");
+    }
     const Box& b = fluid.box;
     if (fluid.shaped()) {
       const std::string& shape = fluid.solid.shape;
@@ -281,6 +308,25 @@ Eigen::Array3i latticeCounts(const Scene& scene, const Box& box) {
     counts[k] = static_cast<int>(std::min(std::max(n, 0.0), 2e9));
   }
   return counts;
+}
+
+size_t Scene::fluidOf(size_t block) const {
+  for (size_t i = 0; i < block; ++i)
+    if (fluids[i].name == fluids[block].name) return i;
+  return block;
+}
+
+bool Scene::severalFluids() const {
+  for (size_t i = 1; i < fluids.size(); ++i)
+    if (fluids[i].name != fluids[0].name) return true;
+  return false;
+}
+
+std::vector<size_t> Scene::laterFluids() const {
+  std::vector<size_t> later;
+  for (size_t i = 1; i < fluids.size(); ++i)
+    if (fluidOf(i) == i) later.push_back(i);
+  return later;
 }
 
 size_t Scene::particleCount() const {

@@ -92,13 +92,14 @@ struct Rasterizer::Impl {
 
   // Water seen at a point with normal n from direction v: Fresnel blend of the reflected sky and the body
   // colour (the floor lit by sun and sky seen through about half a metre of water), plus the sun's highlight.
-  Vec3 waterColour(const Vec3& v, Vec3 n) const {
+  Vec3 waterColour(const Vec3& v, Vec3 n) const { return waterColour(v, n, look.waterAbsorption); }
+  Vec3 waterColour(const Vec3& v, Vec3 n, const Vec3& absorption) const {
     if (n.dot(v) > 0) n = -n;
     const float c = std::clamp(-v.dot(n), 0.0f, 1.0f), m = 1.0f - c;
     const float fresnel = 0.02f + 0.98f * m * m * m * m * m;
     const Vec3 reflected = v - 2.0f * v.dot(n) * n;
     const Vec3 body = look.floorAlbedo * 0.55f *
-                      look.waterAbsorption.unaryExpr([](float a) { return std::exp(-0.5f * a); })
+                      absorption.unaryExpr([](float a) { return std::exp(-0.5f * a); })
                           .cwiseProduct(diffuseLight(Vec3::UnitY()));
     const float highlight = std::pow(std::max(reflected.dot(look.sunDirection), 0.0f), 400.0f);
     return (1.0f - fresnel) * body + fresnel * skyRadiance(look, reflected) +
@@ -419,30 +420,38 @@ Rasterizer::~Rasterizer() {
 }
 
 Image Rasterizer::drawMesh(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders,
-                           const WhitewaterSpheres& whitewater) {
+                           const WhitewaterSpheres& whitewater, const std::vector<FluidMesh>& others) {
   Impl& r = *impl_;
-  for (size_t t = 0; t < water.triangles.size(); ++t)
-    for (uint32_t v : water.triangles[t])
-      if (v >= water.positions.size())
-        throw InputError(
-            "water mesh", "triangle " + std::to_string(t),
-            "names vertex " + std::to_string(v) + " of " + std::to_string(water.positions.size()));
+  auto check = [](const TriangleMesh& mesh) {
+    for (size_t t = 0; t < mesh.triangles.size(); ++t)
+      for (uint32_t v : mesh.triangles[t])
+        if (v >= mesh.positions.size())
+          throw InputError(
+              "water mesh", "triangle " + std::to_string(t),
+              "names vertex " + std::to_string(v) + " of " + std::to_string(mesh.positions.size()));
+  };
+  check(water);
+  for (const FluidMesh& other : others) check(other.mesh);
   OSMesaMakeCurrent(r.context, r.buffer.data(), GL_UNSIGNED_BYTE, r.width, r.height);
   const PinholeCamera camera(r.settings.camera, r.width, r.height);
-  const std::vector<Vec3> normals = vertexNormals(water);
-  std::vector<Rgba> colours(water.positions.size());
   const bool flat = r.scene.dimensions == 2;
-  // In 2D the water is one flat colour (the body seen through the slab), in 3D a Fresnel blend per vertex.
-  const Rgba body2d = display(r.waterColour(-Vec3::UnitZ(), Vec3::UnitZ()), r.look.exposure);
-  parallelFor(0, water.positions.size(), [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i)
-      colours[i] =
-          flat ? body2d
-               : display(r.waterColour((water.positions[i] - camera.position()).normalized(), normals[i]),
-                         r.look.exposure);
-  });
   r.begin(camera);
-  r.drawTriangles(water.positions, colours, water.triangles);
+  // In 2D the water is one flat colour (the body seen through the slab), in 3D a Fresnel blend per vertex.
+  auto drawLiquid = [&](const TriangleMesh& mesh, const Vec3& absorption) {
+    const std::vector<Vec3> normals = vertexNormals(mesh);
+    std::vector<Rgba> colours(mesh.positions.size());
+    const Rgba body2d = display(r.waterColour(-Vec3::UnitZ(), Vec3::UnitZ(), absorption), r.look.exposure);
+    parallelFor(0, mesh.positions.size(), [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i)
+        colours[i] = flat ? body2d
+                          : display(r.waterColour((mesh.positions[i] - camera.position()).normalized(),
+                                                  normals[i], absorption),
+                                    r.look.exposure);
+    });
+    r.drawTriangles(mesh.positions, colours, mesh.triangles);
+  };
+  drawLiquid(water, r.look.waterAbsorption);
+  for (const FluidMesh& other : others) drawLiquid(other.mesh, other.absorption);
   if (!whitewater.empty()) {
     // Each particle a sphere (a disc in front of the 2D slab), diffuse in its albedo under sky and sun.
     const TriangleMesh sphere = unitSphere();

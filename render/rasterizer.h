@@ -17,6 +17,12 @@
 
 namespace surge {
 
+// Another fluid's surface mesh in a scene of several, and its liquid's absorption (Shading::absorptionOf).
+struct FluidMesh {
+  TriangleMesh mesh;
+  Eigen::Vector3f absorption = Eigen::Vector3f::Zero();
+};
+
 class Rasterizer {
  public:
   // One GL context for the scene's resolved resolution (render.quality applies). Throws RunError if OSMesa
@@ -29,8 +35,9 @@ class Rasterizer {
   // Throws InputError if a triangle names a vertex the mesh does not have.
   // With the frame's whitewater as spheres (discs in 2D, at least a spacing across) in their colours, lit as
   // the colliders are.
+  // `others`: the other fluids' meshes of a scene of several, each in its fluid's colour (fluids[i].color).
   Image drawMesh(const TriangleMesh& water, const std::vector<ColliderMesh>& colliders = {},
-                 const WhitewaterSpheres& whitewater = {});
+                 const WhitewaterSpheres& whitewater = {}, const std::vector<FluidMesh>& others = {});
   // Spheres of radius particle_spacing / 2 (in 2D flat discs of 0.8 particle_spacing, overlapping).
   Image drawParticles(const ParticleFrame& particles, const std::vector<ColliderMesh>& colliders = {});
 

@@ -186,6 +186,33 @@ Image traceImage(RenderWorkspace& workspace, const RayDevice& device, const Tria
   return image;
 }
 
+// A scene of several fluids: the meshes of the fluids after the first (surface_<name>/), each with its colour's
+// absorption; none in a scene of one.
+std::vector<FluidMesh> otherFluidMeshes(const fs::path& dir, const Scene& scene, int frame) {
+  std::vector<FluidMesh> others;
+  for (size_t b : scene.laterFluids()) {
+    FluidMesh other;
+    other.mesh = readMeshPly(fluidMeshPath(framePath(dir, "surface", frame, "ply"), scene.fluids[b].name));
+    other.absorption = Shading::absorptionOf(scene.fluids[b].color, scene.render.absorption_distance);
+    others.push_back(std::move(other));
+  }
+  return others;
+}
+
+// The path tracer's one liquid: the first fluid's mesh with the others' appended (they take its absorption).
+TriangleMesh allFluids(TriangleMesh water, const std::vector<FluidMesh>& others) {
+  for (const FluidMesh& other : others) {
+    const uint32_t base = uint32_t(water.positions.size());
+    const bool normals = water.normals.size() == base && other.mesh.normals.size() == other.mesh.positions.size();
+    water.positions.insert(water.positions.end(), other.mesh.positions.begin(), other.mesh.positions.end());
+    if (normals) water.normals.insert(water.normals.end(), other.mesh.normals.begin(), other.mesh.normals.end());
+    else water.normals.clear();
+    water.velocities.clear();
+    for (const auto& t : other.mesh.triangles) water.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  return water;
+}
+
 }  // namespace
 
 RenderSettings resolvedRenderSettings(const RenderSettings& settings) {
@@ -278,6 +305,8 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
     const auto done = [&](int f) {
       std::vector<fs::path> inputs = colliders.frameFiles(f);
       inputs.push_back(framePath(dir, particles ? "particles" : "surface", f, "ply"));
+      for (size_t b : particles ? std::vector<size_t>() : scene.laterFluids())
+        inputs.push_back(fluidMeshPath(framePath(dir, "surface", f, "ply"), scene.fluids[b].name));
       inputs.push_back(settings);
       if (std::error_code error; fs::exists(framePath(dir, "whitewater", f, "ply"), error))
         inputs.push_back(framePath(dir, "whitewater", f, "ply"));
@@ -296,7 +325,7 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
           particles
               ? rasterizer.drawParticles(readParticlePly(framePath(dir, "particles", frame, "ply")), solids)
               : rasterizer.drawMesh(readMeshPly(framePath(dir, "surface", frame, "ply")), solids,
-                                    whitewaterSpheresAt(dir, frame, scene));
+                                    whitewaterSpheresAt(dir, frame, scene), otherFluidMeshes(dir, scene, frame));
       writePng(framePath(dir, "frames", frame, "png"), image);
       progress.advance();
     }
@@ -314,7 +343,8 @@ void renderFrames(const fs::path& dir, const Scene& scene, const FrameRange& ran
     try {
       for (int frame : frames) {
         Progress::checkInterrupt();
-        const TriangleMesh water = readMeshPly(framePath(dir, "surface", frame, "ply"));
+        const TriangleMesh water =
+            allFluids(readMeshPly(framePath(dir, "surface", frame, "ply")), otherFluidMeshes(dir, scene, frame));
         const WhitewaterSpheres whitewater = whitewaterSpheresAt(dir, frame, scene);
         Image image = tracer.render(water, colliders.atFrame(frame), scene, frame, nullptr, &whitewater);
         finishWriting();

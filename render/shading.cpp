@@ -167,6 +167,13 @@ Vec3 sunDisc(const Shading& shading, const Vec3& direction) {
 
 }  // namespace
 
+// Beer-Lambert: exp(-sigma d) = colour at d = absorption_distance, so sigma = -ln(colour) / d.
+Eigen::Vector3f Shading::absorptionOf(const Eigen::Vector3d& color, double distance) {
+  Eigen::Vector3f sigma;
+  for (int k = 0; k < 3; ++k) sigma[k] = float(-std::log(std::clamp(color[k], 1e-3, 1.0)) / std::max(distance, 1e-6));
+  return sigma;
+}
+
 Shading Shading::fromScene(const Scene& scene) {
   const RenderSettings& r = scene.render;
   Shading s;
@@ -177,10 +184,7 @@ Shading Shading::fromScene(const Scene& scene) {
   s.skyZenith = r.sky_zenith.cast<float>();
   s.skyHorizon = r.sky_horizon.cast<float>();
   s.belowHorizon = 0.5f * s.skyHorizon;
-  // Beer-Lambert: exp(-sigma d) = colour at d = absorption_distance, so sigma = -ln(colour) / d.
-  for (int k = 0; k < 3; ++k)
-    s.waterAbsorption[k] =
-        float(-std::log(std::clamp(r.water_color[k], 1e-3, 1.0)) / std::max(r.absorption_distance, 1e-6));
+  s.waterAbsorption = absorptionOf(r.water_color, r.absorption_distance);
   s.tankMin = scene.domain.min.cast<float>();
   s.tankMax = scene.domain.max.cast<float>();
   const float size = std::max((s.tankMax - s.tankMin).maxCoeff(), 1e-3f);

@@ -39,6 +39,9 @@ struct Shading {
   // Water: index of refraction and Beer-Lambert absorption per metre.
   float ior = 1.333f;
   Eigen::Vector3f waterAbsorption = Eigen::Vector3f::Zero();
+  // Beer-Lambert's coefficients of a liquid that turns white light `color` over `distance` (render.water_color
+  // over render.absorption_distance; a fluid's fluids[i].color).
+  static Eigen::Vector3f absorptionOf(const Eigen::Vector3d& color, double distance);
   // The ground: a checkerboard of `checkerSize` squares aligned to the tank, of albedo floorAlbedo inside the
   // tank's footprint and groundAlbedo outside, each square +-checkerContrast; distance haze towards the
   // horizon colour.

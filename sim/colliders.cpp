@@ -460,6 +460,7 @@ size_t removeParticlesInside(const Colliders<Dim>& colliders, ParticleFrame& fra
     frame.position[kept] = frame.position[i];
     frame.velocity[kept] = frame.velocity[i];
     frame.id[kept] = static_cast<uint32_t>(kept);
+    if (!frame.fluid.empty()) frame.fluid[kept] = frame.fluid[i];
     ++kept;
   }
   const size_t removed = frame.size() - kept;

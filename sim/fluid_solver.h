@@ -56,6 +56,8 @@ class FluidSolver {
   virtual const std::vector<Vec<Dim>>& positions() const = 0;
   virtual const std::vector<Vec<Dim>>& velocities() const = 0;
   virtual float particleMass() const = 0;
+  // Each particle's mass over particleMass() in a scene of several fluids (empty in a scene of one).
+  virtual const std::vector<float>& massRatios() const = 0;
 
   // Steps a frame: > 0 for a method that takes at least that many equal steps, shorter ones when stableTimeStep
   // (read before every step) is below them; 0 for one that chooses each step's length from stableTimeStep.

@@ -49,7 +49,7 @@ struct FluidMeasures {
 template <int Dim, typename Walls, typename Weight>
 FluidMeasures measureDensityAndEnergy(const std::vector<Vec<Dim>>& x, const std::vector<Vec<Dim>>& v,
                                       const NeighborLists& neighbors, const Walls& walls, float mass,
-                                      float restDensity, Weight weight) {
+                                      float restDensity, Weight weight, const std::vector<float>& massRatio = {}) {
   struct Sums {
     double errorSum = 0, errorMax = 0, energy = 0;
     Sums& operator+=(const Sums& o) {
@@ -70,7 +70,7 @@ FluidMeasures measureDensityAndEnergy(const std::vector<Vec<Dim>>& x, const std:
       const double error = std::max(double(mass * w / restDensity) - 1.0, 0.0);
       s.errorSum += error;
       s.errorMax = std::max(s.errorMax, error);
-      s.energy += 0.5 * mass * v[i].squaredNorm();
+      s.energy += 0.5 * mass * (massRatio.empty() ? 1.0f : massRatio[i]) * v[i].squaredNorm();
     }
     return s;
   });

@@ -18,8 +18,8 @@ RestLattice<Dim> sphRestLattice(const Scene& scene) {
 template <int Dim>
 ParticleSolver<Dim>::ParticleSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes,
                                     RestLattice<Dim> lattice)
-    : restDensity_(static_cast<float>(scene.solver.rest_density)),
-      mass_(static_cast<float>(scene.solver.rest_density / lattice.weightSum)),
+    : restDensity_(static_cast<float>(scene.referenceDensity())),
+      mass_(static_cast<float>(scene.referenceDensity() / lattice.weightSum)),
       gravity_(toVec<Dim>(scene.gravity)),
       attractor_(scene.attractor),
       tension_(scene, mass_),
@@ -28,6 +28,26 @@ ParticleSolver<Dim>::ParticleSolver(const Scene& scene, std::shared_ptr<const Co
       walls_(std::move(lattice.walls)),
       sceneSpeedLimit_(static_cast<float>(runawaySpeed(scene))) {
   if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
+  if (scene.severalFluids()) {
+    fluidMassRatio_.assign(scene.fluids.size(), 1.0f);
+    for (size_t f = 0; f < scene.fluids.size(); ++f)
+      fluidMassRatio_[f] = static_cast<float>(scene.fluids[f].rest_density / scene.referenceDensity());
+  }
+}
+
+// fluid_ from a frame's (fluid 0 where it has none: an emitter's particles), and massRatio_ from it.
+template <int Dim>
+void ParticleSolver<Dim>::setFluids(const std::vector<uint8_t>& fluids, size_t n) {
+  if (fluidMassRatio_.empty()) return;
+  fluid_ = fluids;
+  fluid_.resize(n, 0);
+  massRatio_.resize(n);
+  inverseMassRatio_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    if (fluid_[i] >= fluidMassRatio_.size()) throw std::invalid_argument("a particle of a fluid the scene has not");
+    massRatio_[i] = fluidMassRatio_[fluid_[i]];
+    inverseMassRatio_[i] = 1.0f / massRatio_[i];
+  }
 }
 
 // Frame files hold 3 components; the channels hold Dim.
@@ -41,6 +61,7 @@ void ParticleSolver<Dim>::setParticles(const ParticleFrame& frame) {
     x_[i] = frame.position[i].head<Dim>();
     v_[i] = frame.velocity[i].head<Dim>();
   }
+  setFluids(frame.fluid, n);
   colliders_.resetSlots(n);
   speedLimit_ = runawaySpeedFor(sceneSpeedLimit_, v_);
   resizeChannels(n);
@@ -58,6 +79,7 @@ void ParticleSolver<Dim>::getParticles(ParticleFrame& frame) const {
     frame.velocity[i].head<Dim>() = v_[i];
   }
   frame.id = id_;
+  frame.fluid = fluid_;
 }
 
 template <int Dim>
@@ -85,11 +107,13 @@ void ParticleSolver<Dim>::editParticles(const ParticleEdit<Dim>& edit) {
     compact(x_);
     compact(v_);
     compact(id_);
+    if (!fluid_.empty()) compact(fluid_);
   }
   x_.insert(x_.end(), edit.addPosition.begin(), edit.addPosition.end());
   v_.insert(v_.end(), edit.addVelocity.begin(), edit.addVelocity.end());
   id_.insert(id_.end(), edit.addId.begin(), edit.addId.end());
   const size_t n = x_.size();
+  if (!fluidMassRatio_.empty()) setFluids(std::vector<uint8_t>(fluid_), n);  // an emitter's are fluid 0
   // The carried channels step aside while the method sizes its others, then come back, new particles at 0.
   size_t channels = 0;
   forEachCarriedChannel([&](std::vector<float>& channel) {
@@ -140,6 +164,7 @@ template <int Dim>
 size_t ParticleSolver<Dim>::coreMemoryBytes() const {
   size_t bytes = (x_.capacity() + v_.capacity() + vectorScratch_.capacity()) * sizeof(VecD);
   bytes += (id_.capacity() + idScratch_.capacity()) * sizeof(uint32_t) + floatScratch_.capacity() * sizeof(float);
+  bytes += fluid_.capacity() + byteScratch_.capacity() + (massRatio_.capacity() + inverseMassRatio_.capacity() + fluidMassRatio_.capacity()) * sizeof(float);
   return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes() + tension_.memoryBytes();
 }
 

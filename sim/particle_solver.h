@@ -102,6 +102,7 @@ class ParticleSolver : public FluidSolver<Dim> {
   const std::vector<VecD>& positions() const final { return x_; }
   const std::vector<VecD>& velocities() const final { return v_; }
   float particleMass() const final { return mass_; }
+  const std::vector<float>& massRatios() const final { return massRatio_; }
   uint32_t particleId(size_t i) const { return id_[i]; }
   PhaseTimes& phaseTimes() final { return times_; }
   double takeForceWork() final { return tension_.active() ? tension_.takeWork() : 0.0; }
@@ -149,7 +150,7 @@ class ParticleSolver : public FluidSolver<Dim> {
   template <typename Weight>
   FluidMeasures measureWith(Weight weight) const {
     return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, Boundary<Dim>{walls_, colliders_}, mass_, restDensity_,
-                                        weight);
+                                        weight, massRatio_);
   }
   // The fastest particle's speed after `dt` of gravity: the CFL conditions' |v|max.
   float fastestAfterFall(float dt);
@@ -167,8 +168,12 @@ class ParticleSolver : public FluidSolver<Dim> {
     tension_.kick(v_, dt);
   }
 
-  // Parameters, fixed at construction.
+  // Parameters, fixed at construction. restDensity_ and mass_ are fluid 0's (Scene::referenceDensity).
   const float restDensity_, mass_;
+  // Several fluids (Scene::severalFluids): each particle's fluid and its mass over mass_ (rho_f / rho_0, its
+  // volume being the lattice's) and its inverse; all empty in a scene of one fluid. fluidMassRatio_ is by fluid.
+  std::vector<uint8_t> fluid_;
+  std::vector<float> massRatio_, inverseMassRatio_, fluidMassRatio_;
   const VecD gravity_;
   const Attractor<Dim> attractor_;
   SurfaceTension<Dim> tension_;  // inactive without surface tension
@@ -184,12 +189,15 @@ class ParticleSolver : public FluidSolver<Dim> {
   std::vector<VecD> vectorScratch_;
   std::vector<float> floatScratch_;
   std::vector<uint32_t> idScratch_;
+  std::vector<uint8_t> byteScratch_;
   PhaseTimes times_;
 
  private:
   std::vector<VecD>& scratchFor(std::vector<VecD>&) { return vectorScratch_; }
   std::vector<float>& scratchFor(std::vector<float>&) { return floatScratch_; }
   std::vector<uint32_t>& scratchFor(std::vector<uint32_t>&) { return idScratch_; }
+
+  void setFluids(const std::vector<uint8_t>& fluids, size_t n);
 
   std::vector<std::vector<float>> carriedHold_;  // editParticles: the carried channels while the rest resize
   float sceneSpeedLimit_;  // runawaySpeed(scene)
@@ -205,6 +213,11 @@ void ParticleSolver<Dim>::reorderByCell(std::vector<VecD>& key, Channels&... cha
   gatherByOrder(order, v_, vectorScratch_);
   if (&key != &x_) gatherByOrder(order, key, vectorScratch_);
   gatherByOrder(order, id_, idScratch_);
+  if (!fluid_.empty()) {
+    gatherByOrder(order, fluid_, byteScratch_);
+    gatherByOrder(order, massRatio_, floatScratch_);
+    gatherByOrder(order, inverseMassRatio_, floatScratch_);
+  }
   [[maybe_unused]] auto gather = [&](auto& channel) {
     if (!channel.empty()) gatherByOrder(order, channel, scratchFor(channel));
   };

@@ -225,9 +225,21 @@ void PbfSolver<Dim>::applyWarmStart() {
 // compression is corrected, so particles at the free surface do not pull together; s_corr handles clumping).
 // Eq. 8: grad_{p_k} C_i = (m / rho_0) sum_j grad W(p_i - p_j) for k = i, and -(m / rho_0) grad W(p_i - p_k)
 // for k = j. Eq. 11: lambda_i = -C_i / (sum_k |grad_{p_k} C_i|^2 + epsilon).
+// With several fluids (Solenthaler and Pajarola 2008's density contrast, as position-based dynamics with masses):
+// the constraint stays the number density's, C_i = V sum_j W - 1, and each particle's move is weighted by its
+// inverse mass w = m_0 / m: lambda_i = -C_i / (w_i |grad_i C_i|^2 + sum_j w_j |grad_j C_i|^2 + epsilon), and
+// eq. 12's delta p_i is times w_i. A heavy particle moves less for the same lambda, so lambda holds up the weight
+// above it (hydrostatic pressure) and a light fluid under a heavy one is pushed up.
 template <int Dim>
 double PbfSolver<Dim>::computeLambdas(float omega) {
+  return massRatio_.empty() ? computeLambdasOf<false>(omega) : computeLambdasOf<true>(omega);
+}
+
+template <int Dim>
+template <bool kSeveral>
+double PbfSolver<Dim>::computeLambdasOf(float omega) {
   const float selfWeight = kernels_.poly6(0.0f);
+  [[maybe_unused]] const float* inverse = inverseMassRatio_.data();  // w
   const double averageError = parallelSum<double>(0, size(), [&](size_t b, size_t e) {
     double errorSum = 0;
     for (size_t i = b; i < e; ++i) {
@@ -255,7 +267,8 @@ double PbfSolver<Dim>::computeLambdas(float omega) {
         g0 += pair.gradientFactor * r0;
         g1 += pair.gradientFactor * r1;
         g2 += pair.gradientFactor * r2;
-        squares += pair.gradientFactor * pair.gradientFactor * length2;
+        if constexpr (kSeveral) squares += pair.gradientFactor * pair.gradientFactor * length2 * inverse[j];
+        else squares += pair.gradientFactor * pair.gradientFactor * length2;
       }
       if (!coincident) [[likely]] {
         weight += w;
@@ -271,7 +284,7 @@ double PbfSolver<Dim>::computeLambdas(float omega) {
           factors[k] = pair.gradientFactor;
           weight += pair.weight;
           gradientSum += pair.gradientFactor * r;
-          gradientSquaredSum += pair.gradientFactor * pair.gradientFactor * r2;
+          gradientSquaredSum += pair.gradientFactor * pair.gradientFactor * r2 * (kSeveral ? inverse[neighbor[k]] : 1.0f);
         }
       }
       VecD gradientI = massOverRho_ * gradientSum;
@@ -288,7 +301,9 @@ double PbfSolver<Dim>::computeLambdas(float omega) {
         gradientI += massOverRho_ * colliderGradient;
       }
       const float constraint = std::max(mass_ * weight / restDensity_ - 1.0f, 0.0f);
-      const float lambda = -constraint / (gradientSquaredSum + gradientI.squaredNorm() + epsilon_);
+      float ownSquared = gradientI.squaredNorm();
+      if constexpr (kSeveral) ownSquared *= inverse[i];
+      const float lambda = -constraint / (gradientSquaredSum + ownSquared + epsilon_);
       // The Chebyshev acceleration (see solveDensityConstraints): lambda_[i] still holds mu_k-1, the multiplier
       // the last iteration applied. != 0 rather than > 0: a NaN constraint passes its NaN on, so that a blow-up
       // still shows.
@@ -382,6 +397,7 @@ void PbfSolver<Dim>::applyPositionCorrections() {
       // The colliders likewise; each one's share is an impulse it gives the particle.
       if (!colliders_.empty() && lambdaI != 0.0f && found_[i].count > 0)
         corrections[i] += colliderCorrection(i, pi, lambdaI);
+      if (!massRatio_.empty()) corrections[i] *= inverseMassRatio_[i];  // w_i (see computeLambdas)
     }
   });
   parallelFor(0, size(), [&](size_t b, size_t e) {

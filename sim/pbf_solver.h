@@ -61,6 +61,7 @@ class PbfSolver final : public ParticleSolver<Dim> {
   // Delegated to by the one above, with the rest lattice through PBF's kernels.
   PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, RestLattice<Dim> lattice);
   using Core::x_, Core::v_, Core::neighbors_, Core::walls_, Core::colliders_, Core::mass_, Core::times_;
+  using Core::massRatio_, Core::inverseMassRatio_;
   using Core::vectorScratch_, Core::restDensity_;
 
   void resizeChannels(size_t n) override;
@@ -73,6 +74,8 @@ class PbfSolver final : public ParticleSolver<Dim> {
   // Eq. 11 (with the Chebyshev weight omega of this iteration, 1 for plain Jacobi); returns the average density
   // error before this iteration's correction.
   double computeLambdas(float omega);
+  template <bool kSeveral>
+  double computeLambdasOf(float omega);
   void applyWarmStart();
   // Eq. 12 from lambda_: an iteration's correction, or with kWarmStart the warm start's (kernel gradients
   // evaluated here rather than read from the lambda pass, no s_corr, nothing added to the lambda totals).

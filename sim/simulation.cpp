@@ -341,8 +341,14 @@ void checkSimulationStart(const Scene& scene, std::shared_ptr<const ColliderShap
 double potentialEnergy(const Scene& scene, const ParticleFrame& frame, double particleMass) {
   const GravityPotential potential(scene);
   double sum = 0;
-  for (const Eigen::Vector3f& x : frame.position) sum += potential.at(x.cast<double>());
-  return particleMass * sum;
+  if (frame.fluid.empty()) {
+    for (const Eigen::Vector3f& x : frame.position) sum += potential.at(x.cast<double>());
+    return particleMass * sum;
+  }
+  // Several fluids: each particle's mass is its fluid's density on the lattice's volume.
+  for (size_t i = 0; i < frame.size(); ++i)
+    sum += scene.fluids[frame.fluid[i]].rest_density * potential.at(frame.position[i].cast<double>());
+  return particleMass / scene.referenceDensity() * sum;
 }
 
 DamBreakMeasures measureDamBreak(const Scene& scene, const ParticleFrame& frame) {
@@ -384,22 +390,25 @@ ParticleFrame initialParticles(const Scene& scene) {
   frame.velocity.reserve(total);
   frame.id.reserve(total);
   const double spacing = scene.particle_spacing;
+  const bool several = scene.severalFluids();
   for (size_t f = 0; f < scene.fluids.size(); ++f) {
     const FluidBlock& fluid = scene.fluids[f];
     if (fluid.shaped()) {
       addShapedFluid(scene, f, frame);
-      continue;
+    } else {
+      const Eigen::Array3i n = latticeCounts(scene, fluid.box);
+      for (int k = 0; k < n[2]; ++k)
+        for (int j = 0; j < n[1]; ++j)
+          for (int i = 0; i < n[0]; ++i) {
+            Eigen::Vector3d p = fluid.box.min + spacing * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5);
+            if (scene.dimensions == 2) p.z() = 0;
+            frame.position.push_back(p.cast<float>());
+            frame.velocity.push_back(fluid.velocity.cast<float>());
+            frame.id.push_back(static_cast<uint32_t>(frame.id.size()));
+          }
     }
-    const Eigen::Array3i n = latticeCounts(scene, fluid.box);
-    for (int k = 0; k < n[2]; ++k)
-      for (int j = 0; j < n[1]; ++j)
-        for (int i = 0; i < n[0]; ++i) {
-          Eigen::Vector3d p = fluid.box.min + spacing * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5);
-          if (scene.dimensions == 2) p.z() = 0;
-          frame.position.push_back(p.cast<float>());
-          frame.velocity.push_back(fluid.velocity.cast<float>());
-          frame.id.push_back(static_cast<uint32_t>(frame.id.size()));
-        }
+    // Where there are several fluids, each block's particles carry its fluid.
+    if (several) frame.fluid.resize(frame.size(), static_cast<uint8_t>(scene.fluidOf(f)));
   }
   return frame;
 }

@@ -494,13 +494,15 @@ void writeMeshObj(const fs::path& path, const TriangleMesh& mesh) {
 // the VDB holds their level sets after the water's grids (planes have none: a half-space has no narrow band).
 SurfaceStats surfaceFrameWith(const ParticleFrame& frame, const Scene& scene, const fs::path& vdbPath,
                               const fs::path& meshPath, const std::vector<SurfaceCollider>& colliders,
-                              const DiffuseFrame* whitewater = nullptr) {
+                              const DiffuseFrame* whitewater = nullptr,
+                              const std::vector<FloatGrid::ConstPtr>& otherFluids = {}) {
   const FloatGrid::Ptr grid = buildLevelSet(frame, scene, colliders);
   TriangleMesh mesh = meshLevelSet(*grid, scene.surface.adaptivity);
   if (!colliders.empty()) snapOutOfColliders(mesh, colliders, grid->voxelSize()[0]);
 
   const Parameters p = resolve(frame, scene);
   VdbExtras extras;
+  extras.fluids = otherFluids;
   BlockField velocity;
   std::vector<Eigen::Vector3f> x, v;
   const bool meshVelocity =
@@ -554,6 +556,36 @@ SurfaceStats surfaceFrameWith(const ParticleFrame& frame, const Scene& scene, co
   return stats;
 }
 
+// The particles of fluid `fluid` (Scene::fluidOf) of a frame of several, as a frame of one.
+ParticleFrame particlesOfFluid(const ParticleFrame& frame, uint8_t fluid) {
+  ParticleFrame part;
+  part.dimensions = frame.dimensions;
+  for (size_t i = 0; i < frame.size(); ++i)
+    if (frame.fluid[i] == fluid) {
+      part.position.push_back(frame.position[i]);
+      part.velocity.push_back(frame.velocity[i]);
+      part.id.push_back(frame.id[i]);
+    }
+  return part;
+}
+
+// A frame of several fluids: each fluid after the first made a level set `surface_<name>` and a mesh
+// surface_<name>/frame_NNNNN.ply (fluidMeshPath), then the first as a frame of one with those grids beside it.
+SurfaceStats surfaceFluids(const ParticleFrame& frame, const Scene& scene, const fs::path& vdbPath,
+                           const fs::path& meshPath, const std::vector<SurfaceCollider>& colliders,
+                           const DiffuseFrame* whitewater) {
+  std::vector<FloatGrid::ConstPtr> others;
+  for (size_t f : scene.laterFluids()) {
+    const FloatGrid::Ptr grid = buildLevelSet(particlesOfFluid(frame, uint8_t(f)), scene, colliders);
+    grid->setName("surface_" + scene.fluids[f].name);
+    TriangleMesh mesh = meshLevelSet(*grid, scene.surface.adaptivity);
+    if (!colliders.empty()) snapOutOfColliders(mesh, colliders, grid->voxelSize()[0]);
+    writeMeshPly(fluidMeshPath(meshPath, scene.fluids[f].name), mesh);
+    others.push_back(grid);
+  }
+  return surfaceFrameWith(particlesOfFluid(frame, 0), scene, vdbPath, meshPath, colliders, whitewater, others);
+}
+
 }  // namespace
 
 SurfaceStats surfaceFrame(const ParticleFrame& frame, const Scene& scene, const fs::path& vdbPath,
@@ -573,6 +605,7 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
         dir.string(), "--frames",
         "no particle frame in " + std::to_string(range.first) + ":" + std::to_string(range.last));
   for (const char* ext : {"vdb", "ply", "obj"}) removeTemporaries(dir, "surface", ext, range);
+  for (size_t b : scene.laterFluids()) removeTemporaries(dir, "surface_" + scene.fluids[b].name, "ply", range);
   // Written before any frame, so that every frame made with these settings is newer than it.
   const fs::path settings = writeStageSettings(dir, "surface", scene);
   if (resume) {
@@ -580,6 +613,8 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
       std::vector<fs::path> outputs = {framePath(dir, "surface", f, "vdb"),
                                        framePath(dir, "surface", f, "ply")};
       if (scene.surface.write_obj) outputs.push_back(framePath(dir, "surface", f, "obj"));
+      for (size_t b : scene.laterFluids())
+        outputs.push_back(fluidMeshPath(framePath(dir, "surface", f, "ply"), scene.fluids[b].name));
       std::vector<fs::path> inputs = {framePath(dir, "particles", f, "ply"), settings};
       if (std::error_code error; fs::exists(framePath(dir, "whitewater", f, "ply"), error))
         inputs.push_back(framePath(dir, "whitewater", f, "ply"));
@@ -613,9 +648,11 @@ void surfaceFrames(const fs::path& dir, const Scene& scene, const FrameRange& ra
           DiffuseFrame diffuse;
           const bool whitewater = readDiffusePlyIfPresent(framePath(dir, "whitewater", f, "ply"), diffuse);
           runIsolated([&] {
-            surfaceFrameWith(frame, scene, framePath(dir, "surface", f, "vdb"), framePath(dir, "surface", f, "ply"),
-                             colliders.empty() ? std::vector<SurfaceCollider>() : colliders.atFrame(f),
-                             whitewater ? &diffuse : nullptr);
+            const fs::path vdb = framePath(dir, "surface", f, "vdb"), mesh = framePath(dir, "surface", f, "ply");
+            const std::vector<SurfaceCollider> solids =
+                colliders.empty() ? std::vector<SurfaceCollider>() : colliders.atFrame(f);
+            if (!frame.fluid.empty()) surfaceFluids(frame, scene, vdb, mesh, solids, whitewater ? &diffuse : nullptr);
+            else surfaceFrameWith(frame, scene, vdb, mesh, solids, whitewater ? &diffuse : nullptr);
           });
           const std::lock_guard<std::mutex> lock(advance);
           progress.advance();

@@ -122,6 +122,7 @@ class SeekableArchive : public openvdb::io::Archive {
 
 void writeSurfaceVdb(const fs::path& path, const openvdb::FloatGrid::Ptr& surface, const VdbExtras& extras) {
   openvdb::GridCPtrVec grids{surface};
+  grids.insert(grids.end(), extras.fluids.begin(), extras.fluids.end());
   if (extras.velocity) grids.push_back(velocityGrid(*extras.velocity, surface->transform()));
   if (extras.pointPositions)
     grids.push_back(pointsGrid("points", *extras.pointPositions, *extras.pointVelocities, extras.pointVoxel));

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# The cost of several fluids (issue 34): oil_and_water as it ships (oil at 900 kg/m^3 on water) beside the same
+# blocks as one fluid (both named water, at 1000), run one after the other in this script at the same fixed steps
+# (8 a frame, 4 iterations), so that the time a step compares step for step; the share of a step the inverse-mass
+# weighting adds (docs/several-fluids.md). Each run three times, the fastest kept (a shared machine).
+#
+#   scripts/bench_several_fluids.sh [SURGE_BINARY] [FRAMES]
+set -euo pipefail
+surge=${1:-build/apps/surge}
+frames=${2:-60}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+scene=scenes/oil_and_water.json
+common=(--set output.frames="$frames" --set solver.substeps=8 --quiet)
+perstep() {  # perstep STATS COLUMN: ms a step over frames 1..N (wall_seconds in s, the ms_ columns in ms)
+  awk -F, -v c="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next }
+    $1 > 0 { sum += $col[c]; steps += $col["substeps"] }
+    END { printf "%.4f", (c == "wall_seconds" ? 1000 : 1) * sum / steps }' "$1"
+}
+best() {  # best NAME ARGS...: the fastest of three runs' ms a step, and its constraint phase's
+  local name=$1 fastest="" phase=""
+  shift
+  for run in 1 2 3; do
+    "$surge" sim "$scene" --out "$work/$name" "${common[@]}" "$@"
+    local step; step=$(perstep "$work/$name/stats.csv" wall_seconds)
+    if [ -z "$fastest" ] || awk -v a="$step" -v b="$fastest" 'BEGIN { exit !(a < b) }'; then
+      fastest=$step phase=$(perstep "$work/$name/stats.csv" ms_constraint)
+    fi
+  done
+  echo "$fastest $phase"
+}
+read -r two twoPhase < <(best two)
+read -r one onePhase < <(best one --set 'fluids[1].name=water' --set 'fluids[1].rest_density=1000' \
+  --set 'fluids[1].color=[0.15,0.45,0.8]')
+awk -v t="$two" -v o="$one" -v tp="$twoPhase" -v op="$onePhase" 'BEGIN {
+  printf "| run | ms a step | constraint phase, ms a step |\n|---|---|---|\n"
+  printf "| one fluid | %.2f | %.2f |\n| two fluids | %.2f | %.2f |\n", o, op, t, tp
+  printf "two fluids cost %.2fx a step (%+.0f%% of one fluid'"'"'s step)\n", t / o, 100 * (t - o) / o }'
