@@ -15,6 +15,7 @@ struct TriangleMesh {
   std::vector<Eigen::Vector3f> normals;  // one per vertex, or empty
   std::vector<std::array<uint32_t, 3>> triangles;
   std::vector<Eigen::Vector3f> velocities;  // one per vertex (a surface's, for motion blur), or empty
+  std::vector<uint8_t> fluid;  // one per triangle where a mesh joins several fluids' surfaces (the renderers), or empty
 };
 
 }  // namespace surge

@@ -117,10 +117,6 @@ void validateFluids(Scene& s, const std::string& where) {
                        "differs from fluids[" + std::to_string(s.fluidOf(i)) + "]'s, a block of the same fluid '" +
                            fluid.name + "': give it another name");
     if (fluid.name != s.fluids[0].name && i == s.fluidOf(i)) {  // the scene's second fluid, or a later one
-      if (s.solver.method != "pbf")
-        throw InputError(where, key + ".name",
-                         "a second fluid ('" + fluid.name + "') runs with solver.method pbf only, so far (not " +
-                             s.solver.method + ")");
       if (fluid.surface_tension > 0 || s.fluids[0].surface_tension > 0)
         throw InputError(where, key + ".surface_tension", "surface tension with several fluids is not built yet");
     }

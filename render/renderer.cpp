@@ -199,9 +199,12 @@ std::vector<FluidMesh> otherFluidMeshes(const fs::path& dir, const Scene& scene,
   return others;
 }
 
-// The path tracer's one liquid: the first fluid's mesh with the others' appended (they take its absorption).
+// The path tracer's liquids: the first fluid's mesh with the others' appended, each triangle marked with its
+// fluid (TriangleMesh::fluid, the index into Shading::fluidAbsorption).
 TriangleMesh allFluids(TriangleMesh water, const std::vector<FluidMesh>& others) {
-  for (const FluidMesh& other : others) {
+  if (!others.empty()) water.fluid.assign(water.triangles.size(), 0);
+  for (size_t k = 0; k < others.size(); ++k) {
+    const FluidMesh& other = others[k];
     const uint32_t base = uint32_t(water.positions.size());
     const bool normals = water.normals.size() == base && other.mesh.normals.size() == other.mesh.positions.size();
     water.positions.insert(water.positions.end(), other.mesh.positions.begin(), other.mesh.positions.end());
@@ -209,6 +212,7 @@ TriangleMesh allFluids(TriangleMesh water, const std::vector<FluidMesh>& others)
     else water.normals.clear();
     water.velocities.clear();
     for (const auto& t : other.mesh.triangles) water.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    water.fluid.resize(water.triangles.size(), uint8_t(std::min<size_t>(k + 1, 255)));
   }
   return water;
 }

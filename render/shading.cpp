@@ -100,14 +100,23 @@ Vec3 sampleSun(const Shading& shading, SampleRandom& random) {
   return (cosTheta * shading.sunDirection + sinTheta * (std::cos(phi) * a + std::sin(phi) * b)).normalized();
 }
 
-Vec3 absorb(const Shading& shading, float distance) {
-  return (-distance * shading.waterAbsorption).array().exp().matrix();
+// Which liquids a path is in: bit f set inside fluid f's surface (Hit::fluid). A scene of one fluid has 0 (air)
+// and 1 (water); where two liquids' surfaces overlap at their interface, two bits.
+using Media = uint32_t;
+Media mediaBit(const Hit& hit) { return 1u << std::min<unsigned>(hit.fluid, 31u); }
+
+Vec3 absorb(const Shading& shading, Media media, float distance) {
+  if (media == 1) return (-distance * shading.waterAbsorption).array().exp().matrix();
+  Vec3 sigma = Vec3::Zero();
+  for (size_t f = 0; f < shading.fluidAbsorption.size() && f < 32; ++f)
+    if (media & (1u << f)) sigma += shading.fluidAbsorption[f];
+  return (-distance * sigma).array().exp().matrix();
 }
 
 // How much sunlight arrives along a straight shadow ray: 0 if the ground or a collider blocks it, else the
 // product of the Fresnel transmissions and the absorption of the water and the glass walls it crosses.
 Vec3 sunTransmittance(const RayScene& world, const Shading& shading, const Vec3& origin,
-                      const Vec3& direction, bool inside, PathStats& stats) {
+                      const Vec3& direction, Media media, PathStats& stats) {
   Vec3 transmittance = Vec3::Ones();
   Ray ray;
   ray.origin = origin;
@@ -116,17 +125,20 @@ Vec3 sunTransmittance(const RayScene& world, const Shading& shading, const Vec3&
     Hit hit;
     ++stats.rays;
     if (!world.intersect(ray, kFar, hit, true)) return transmittance;
-    if (inside) transmittance = transmittance.cwiseProduct(absorb(shading, hit.distance));
+    if (media) transmittance = transmittance.cwiseProduct(absorb(shading, media, hit.distance));
     if (hit.kind == SurfaceKind::TankGlass) {
       transmittance *= 1.0f - slabReflectance(std::abs(direction.dot(hit.geometricNormal)), shading.glassIor);
       ray.origin = hit.passPoint;
       continue;
     }
     if (hit.kind != SurfaceKind::Water) return Vec3::Zero();
-    float cosT = 0;
-    const float cosI = std::abs(direction.dot(hit.geometricNormal));
-    transmittance *= 1.0f - fresnelDielectric(cosI, inside ? shading.ior : 1.0f / shading.ior, cosT);
-    inside = !inside;
+    const Media after = media ^ mediaBit(hit);
+    if (!media || !after) {  // liquid and air meet; between two liquids (of one index) the light passes
+      float cosT = 0;
+      const float cosI = std::abs(direction.dot(hit.geometricNormal));
+      transmittance *= 1.0f - fresnelDielectric(cosI, media ? shading.ior : 1.0f / shading.ior, cosT);
+    }
+    media = after;
     ray.origin = hit.passPoint;
   }
   return Vec3::Zero();
@@ -185,6 +197,11 @@ Shading Shading::fromScene(const Scene& scene) {
   s.skyHorizon = r.sky_horizon.cast<float>();
   s.belowHorizon = 0.5f * s.skyHorizon;
   s.waterAbsorption = absorptionOf(r.water_color, r.absorption_distance);
+  if (scene.severalFluids()) {  // in the order of the meshes: the first fluid's, then Scene::laterFluids
+    s.waterAbsorption = absorptionOf(scene.fluids[0].color, r.absorption_distance);
+    s.fluidAbsorption.push_back(s.waterAbsorption);
+    for (size_t b : scene.laterFluids()) s.fluidAbsorption.push_back(absorptionOf(scene.fluids[b].color, r.absorption_distance));
+  }
   s.tankMin = scene.domain.min.cast<float>();
   s.tankMax = scene.domain.max.cast<float>();
   const float size = std::max((s.tankMax - s.tankMin).maxCoeff(), 1e-3f);
@@ -235,7 +252,7 @@ Vec3 diffuseAlbedo(const Shading& shading, const Hit& hit, float travelled) {
 // gather).
 struct PathState {
   Ray ray;
-  bool inside = false;  // the camera is assumed to be in air
+  Media media = 0;  // the camera is assumed to be in air
   bool specular = true;
   float travelled = 0;
   int depth = 0;
@@ -275,8 +292,8 @@ struct GuideChain {
   }
 };
 
-// The chain on its own from `ray` on (inside water or not, `travelled` so far).
-void continueChain(const RayScene& world, const Shading& shading, Ray ray, bool inside, float travelled,
+// The chain on its own from `ray` on (in the liquids `media`, `travelled` so far).
+void continueChain(const RayScene& world, const Shading& shading, Ray ray, Media media, float travelled,
                    GuideChain& chain, PathStats& stats) {
   while (!chain.done) {
     Hit hit;
@@ -291,16 +308,22 @@ void continueChain(const RayScene& world, const Shading& shading, Ray ray, bool 
       ray.origin = hit.passPoint;
       continue;
     }
+    const Media after = media ^ mediaBit(hit);
+    if (media && after) {  // from one liquid into another: straight on
+      ray.origin = hit.passPoint;
+      media = after;
+      continue;
+    }
     float fresnel = 1;
     Vec3 reflected, refracted;
-    if (!waterEventAt(shading, hit, inside, ray.direction, fresnel, reflected, refracted)) {
+    if (!waterEventAt(shading, hit, media != 0, ray.direction, fresnel, reflected, refracted)) {
       chain.finish();
       return;
     }
     if (fresnel < 1.0f) {
       ray.origin = hit.passPoint;
       ray.direction = refracted;
-      inside = !inside;
+      media = after;
     } else {
       ray.origin = hit.leavePoint;
       ray.direction = reflected;
@@ -320,10 +343,10 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
   Vec3& throughput = path.throughput;
   Ray& ray = path.ray;
   // Where the path leaves the chain's way, the chain goes on alone along `next`.
-  const auto partFromChain = [&](const Ray& next, bool inside) {
+  const auto partFromChain = [&](const Ray& next, Media media) {
     if (!path.onChain) return;
     path.onChain = false;
-    continueChain(world, shading, next, inside, path.travelled, *chain, stats);
+    continueChain(world, shading, next, media, path.travelled, *chain, stats);
   };
   for (; path.depth < shading.maxDepth; ++path.depth) {
     Hit hit;
@@ -334,7 +357,7 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
       if (path.onChain) chain->finish();
       return radiance;
     }
-    if (path.inside) throughput = throughput.cwiseProduct(absorb(shading, hit.distance));
+    if (path.media) throughput = throughput.cwiseProduct(absorb(shading, path.media, hit.distance));
     if (path.specular) path.travelled += hit.distance;
     if (path.onChain && !chain->meet(shading, hit, path.travelled)) path.onChain = false;
     if (path.specular && hit.kind == SurfaceKind::Ground) {
@@ -346,9 +369,16 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
     }
 
     if (hit.kind == SurfaceKind::Water) {
+      const Media after = path.media ^ mediaBit(hit);
+      if (path.media && after) {  // from one liquid into another (of one index): straight on, not a segment
+        ray.origin = hit.passPoint;
+        path.media = after;
+        --path.depth;
+        continue;
+      }
       float fresnel = 1;
       Vec3 reflected, refracted;
-      if (!waterEventAt(shading, hit, path.inside, ray.direction, fresnel, reflected, refracted)) {
+      if (!waterEventAt(shading, hit, path.media != 0, ray.direction, fresnel, reflected, refracted)) {
         if (path.onChain) chain->finish();
         return radiance;
       }
@@ -363,7 +393,7 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
         mirror.throughput *= fresnel;
         through.ray.origin = hit.passPoint;
         through.ray.direction = refracted;
-        through.inside = !path.inside;
+        through.media = after;
         through.throughput *= 1.0f - fresnel;
         mirror.onChain = false;  // the chain refracts
         const Vec3 mirrored = gather(world, shading, mirror, random, stats);
@@ -371,13 +401,13 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
         return radiance + mirrored + gather(world, shading, through, random, stats, nullptr, chain);
       }
       if (fresnel >= 1.0f || random.next() < fresnel) {
-        if (fresnel < 1.0f) partFromChain(Ray{hit.passPoint, refracted}, !path.inside);
+        if (fresnel < 1.0f) partFromChain(Ray{hit.passPoint, refracted}, after);
         ray.origin = hit.leavePoint;
         ray.direction = reflected;
       } else {
         ray.origin = hit.passPoint;
         ray.direction = refracted;
-        path.inside = !path.inside;
+        path.media = after;
       }
     } else if (hit.kind == SurfaceKind::TankGlass) {
       const float reflectance = slabReflectance(-ray.direction.dot(hit.geometricNormal), shading.glassIor);
@@ -401,7 +431,7 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
                gather(world, shading, through, random, stats, reflection, chain);
       }
       if (random.next() < reflectance) {
-        partFromChain(Ray{hit.passPoint, ray.direction}, path.inside);
+        partFromChain(Ray{hit.passPoint, ray.direction}, path.media);
         ray.origin = hit.leavePoint;
         ray.direction = reflected;
       } else {
@@ -418,10 +448,10 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
       const Vec3 toSun = sampleSun(shading, random);
       const float cosine = hit.normal.dot(toSun);
       if (cosine > 0) {
-        const Vec3 sun = sunTransmittance(world, shading, hit.leavePoint, toSun, path.inside, stats);
+        const Vec3 sun = sunTransmittance(world, shading, hit.leavePoint, toSun, path.media, stats);
         radiance += cosine * throughput.cwiseProduct(albedo).cwiseProduct(sun).cwiseProduct(shading.sunColor);
       }
-      if (hit.kind == SurfaceKind::Whitewater && !path.inside) {
+      if (hit.kind == SurfaceKind::Whitewater && !path.media) {
         // One bounce for spray and foam in air: the sky along the normal stands for the rest of the path (paths
         // followed on among the white spheres cost the demo 28% more render time). Bubbles, under water, go on
         // as any diffuse surface does, lit through the water around them.
@@ -444,7 +474,7 @@ Vec3 gather(const RayScene& world, const Shading& shading, PathState path, Sampl
       throughput /= survive;
     }
   }
-  partFromChain(ray, path.inside);  // the path stopped (roulette, depth) where the chain had not
+  partFromChain(ray, path.media);  // the path stopped (roulette, depth) where the chain had not
   return radiance;
 }
 

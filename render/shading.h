@@ -39,6 +39,9 @@ struct Shading {
   // Water: index of refraction and Beer-Lambert absorption per metre.
   float ior = 1.333f;
   Eigen::Vector3f waterAbsorption = Eigen::Vector3f::Zero();
+  // A scene of several fluids: each fluid's absorption by Hit::fluid (the first is waterAbsorption); empty in a
+  // scene of one. Two liquids meet without refraction (one index).
+  std::vector<Eigen::Vector3f> fluidAbsorption;
   // Beer-Lambert's coefficients of a liquid that turns white light `color` over `distance` (render.water_color
   // over render.absorption_distance; a fluid's fluids[i].color).
   static Eigen::Vector3f absorptionOf(const Eigen::Vector3d& color, double distance);

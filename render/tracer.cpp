@@ -282,6 +282,7 @@ bool RayScene::intersect(const Ray& ray, float maxDistance, Hit& hit, bool shado
   hit.normal = ng;
   hit.leavePoint = hit.point + offset_ * ng;
   hit.passPoint = hit.point - offset_ * ng;
+  if (hit.kind == SurfaceKind::Water && !impl_->water->fluid.empty()) hit.fluid = impl_->water->fluid[query.hit.primID];
   if (hit.kind == SurfaceKind::Water && impl_->smooth)
     smoothShading(*impl_->water, impl_->water->triangles[query.hit.primID], query.hit.u, query.hit.v, hit);
   if (collider) {

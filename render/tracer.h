@@ -44,6 +44,7 @@ struct Hit {
   // Where refracted rays start: the point pushed just through the surface.
   Eigen::Vector3f passPoint = Eigen::Vector3f::Zero();
   Eigen::Vector3f albedo = Eigen::Vector3f::Zero();  // a collider's or a whitewater particle's colour
+  uint8_t fluid = 0;  // a water hit's fluid (TriangleMesh::fluid; 0 in a scene of one)
 };
 
 class RayScene {

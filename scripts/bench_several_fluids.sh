@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # The cost of several fluids (issue 34): oil_and_water as it ships (oil at 900 kg/m^3 on water) beside the same
-# blocks as one fluid (both named water, at 1000), run one after the other in this script at the same fixed steps
-# (8 a frame, 4 iterations), so that the time a step compares step for step; the share of a step the inverse-mass
-# weighting adds (docs/several-fluids.md). Each run three times, the fastest kept (a shared machine).
+# blocks as one fluid (both named water, at 1000), run one after the other in this script, in each method (PBF at
+# its 8 steps a frame and 4 iterations; DFSPH and WCSPH at their own steps), so that the time a step compares step
+# for step; the share of a step the inverse-mass weighting adds (docs/several-fluids.md). Each run three times,
+# the fastest kept (a shared machine).
 #
 #   scripts/bench_several_fluids.sh [SURGE_BINARY] [FRAMES]
+#   METHODS="pbf dfsph" scripts/bench_several_fluids.sh ...   (a subset of the methods)
 set -euo pipefail
 surge=${1:-build/apps/surge}
 frames=${2:-60}
@@ -29,10 +31,12 @@ best() {  # best NAME ARGS...: the fastest of three runs' ms a step, and its con
   done
   echo "$fastest $phase"
 }
-read -r two twoPhase < <(best two)
-read -r one onePhase < <(best one --set 'fluids[1].name=water' --set 'fluids[1].rest_density=1000' \
-  --set 'fluids[1].color=[0.15,0.45,0.8]')
-awk -v t="$two" -v o="$one" -v tp="$twoPhase" -v op="$onePhase" 'BEGIN {
-  printf "| run | ms a step | constraint phase, ms a step |\n|---|---|---|\n"
-  printf "| one fluid | %.2f | %.2f |\n| two fluids | %.2f | %.2f |\n", o, op, t, tp
-  printf "two fluids cost %.2fx a step (%+.0f%% of one fluid'"'"'s step)\n", t / o, 100 * (t - o) / o }'
+echo "| method | one fluid, ms a step | two fluids | ratio | pressure phase, one | two |"
+echo "|---|---|---|---|---|---|"
+for method in ${METHODS:-pbf dfsph wcsph}; do
+  read -r two twoPhase < <(best two --set solver.method="$method")
+  read -r one onePhase < <(best one --set solver.method="$method" --set 'fluids[1].name=water' \
+    --set 'fluids[1].rest_density=1000' --set 'fluids[1].color=[0.15,0.45,0.8]')
+  awk -v m="$method" -v t="$two" -v o="$one" -v tp="$twoPhase" -v op="$onePhase" \
+    'BEGIN { printf "| %s | %.2f | %.2f | %.3f | %.2f | %.2f |\n", m, o, t, t / o, op, tp }'
+done

@@ -469,11 +469,12 @@ size_t removeParticlesInside(const Colliders<Dim>& colliders, ParticleFrame& fra
 }
 
 template <int Dim>
-void driftAgainstSolids(std::vector<Vec<Dim>>& x, std::vector<Vec<Dim>>& v, float dt, float mass,
-                        Colliders<Dim>& colliders, const TankWalls<Dim>& walls) {
+void driftAgainstSolids(std::vector<Vec<Dim>>& x, std::vector<Vec<Dim>>& v, float dt, float referenceMass,
+                        const std::vector<float>& massRatio, Colliders<Dim>& colliders, const TankWalls<Dim>& walls) {
   parallelFor(0, x.size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const Vec<Dim> from = x[i];
+      const float mass = massRatio.empty() ? referenceMass : referenceMass * massRatio[i];
       x[i] += dt * v[i];
       if (!colliders.empty()) {
         colliders.project(from, x[i], true, [&](size_t c, const Vec<Dim>& delta) {
@@ -499,9 +500,9 @@ template class Colliders<2>;
 template class Colliders<3>;
 template size_t removeParticlesInside(const Colliders<2>&, ParticleFrame&);
 template size_t removeParticlesInside(const Colliders<3>&, ParticleFrame&);
-template void driftAgainstSolids(std::vector<Vec<2>>&, std::vector<Vec<2>>&, float, float, Colliders<2>&,
-                                 const TankWalls<2>&);
-template void driftAgainstSolids(std::vector<Vec<3>>&, std::vector<Vec<3>>&, float, float, Colliders<3>&,
-                                 const TankWalls<3>&);
+template void driftAgainstSolids(std::vector<Vec<2>>&, std::vector<Vec<2>>&, float, float, const std::vector<float>&,
+                                 Colliders<2>&, const TankWalls<2>&);
+template void driftAgainstSolids(std::vector<Vec<3>>&, std::vector<Vec<3>>&, float, float, const std::vector<float>&,
+                                 Colliders<3>&, const TankWalls<3>&);
 
 }  // namespace surge

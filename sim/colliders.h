@@ -354,10 +354,11 @@ size_t removeParticlesInside(const Colliders<Dim>& colliders, ParticleFrame& fra
 // Moves every particle by dt v (x += dt v), stopped at the colliders and the tank: the collision
 // response. A particle stopped at a collider loses its velocity into it, relative to the wall's own, and that
 // change is the collider's impulse; friction acts on the particles touching one; at a tank wall the particle is
-// clamped a radius inside and loses its velocity into that wall.
+// clamped a radius inside and loses its velocity into that wall. A particle's mass is referenceMass times its
+// massRatio (ParticleSolver::massRatios; empty: all referenceMass).
 template <int Dim>
-void driftAgainstSolids(std::vector<Vec<Dim>>& x, std::vector<Vec<Dim>>& v, float dt, float mass,
-                        Colliders<Dim>& colliders, const TankWalls<Dim>& walls);
+void driftAgainstSolids(std::vector<Vec<Dim>>& x, std::vector<Vec<Dim>>& v, float dt, float referenceMass,
+                        const std::vector<float>& massRatio, Colliders<Dim>& colliders, const TankWalls<Dim>& walls);
 
 // The tank and the colliders together, as the measures see them.
 template <int Dim>

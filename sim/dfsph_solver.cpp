@@ -73,7 +73,7 @@ long DfsphSolver<Dim>::step(float dt, double time) {
     if (!colliders_.empty()) recordColliderImpulses(densityWarm_, dt);
   }
   if (!colliders_.empty()) colliders_.beginStep(time, dt);
-  driftAgainstSolids(x_, v_, dt, mass_, colliders_, walls_);
+  driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_);
 
   // The new positions' neighbours and factors, and Algorithm 2: the divergence solver on v.
   prepareStep();
@@ -95,16 +95,20 @@ void DfsphSolver<Dim>::prepareStep() {
     if (xsphC_ > 0) sizeForPairs(neighbors_, pairWeights_);
   }
   kernel_.visit([&](const auto& kernel) {
-    computeFactors(kernel);
+    if (inverseMassRatio_.empty()) computeFactors<false>(kernel);
+    else computeFactors<true>(kernel);
     return 0;
   });
   prepared_ = true;
 }
 
 // rho_i / rho_0 = V (W(0) + sum_j W_ij + the walls' sum), g_ij = V grad W_ij, G_i = V (the walls' gradient sum),
-// S_i, and the moving walls' share of the divergence.
+// S_i, and the moving walls' share of the divergence. With several fluids (kSeveral) each particle's move is
+// weighted by its inverse mass w = m_0 / m, as PBF's (Solenthaler and Pajarola 2008's number density, as
+// position-based dynamics with masses): S_i = w_i |sum_j g_ij + G_i|^2 + sum_j w_j |g_ij|^2, and applyIncrements
+// moves v_i by w_i times the pressure's change. The density ratio stays the number density's.
 template <int Dim>
-template <typename Kernel>
+template <bool kSeveral, typename Kernel>
 void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
   const PhaseTimer timer(times_.pressure);
   const size_t n = size();
@@ -114,6 +118,7 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
   const bool colliding = !colliders_.empty();
   if (colliding) wallFlux_.resize(n);
   const float selfWeight = kernel.value(0.0f);
+  [[maybe_unused]] const float* inverse = inverseMassRatio_.data();  // w
   parallelFor(0, n, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const VecD xi = x_[i];
@@ -128,7 +133,8 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
         if (w) *w++ = k.value;
         *g = (volume_ * k.gradientFactor) * r;
         sum += *g;
-        squares += g->squaredNorm();
+        if constexpr (kSeveral) squares += inverse[*j] * g->squaredNorm();
+        else squares += g->squaredNorm();
       }
       float wallWeight = 0;
       VecD wall = VecD::Zero();
@@ -148,7 +154,9 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
 
       wallGradient_[i] = volume_ * wall;
       densityRatio_[i] = volume_ * (weight + wallWeight);
-      diagonal_[i] = (sum + wallGradient_[i]).squaredNorm() + squares;
+      float own = (sum + wallGradient_[i]).squaredNorm();
+      if constexpr (kSeveral) own *= inverse[i];
+      diagonal_[i] = own + squares;
     }
   });
 }
@@ -192,13 +200,14 @@ float DfsphSolver<Dim>::residual(size_t i, bool density, float dt) const {
 template <int Dim>
 void DfsphSolver<Dim>::applyIncrements(const std::vector<float>& increments, float dt, std::vector<float>& total) {
   const float inverseDt = 1.0f / dt;
+  const float* inverse = inverseMassRatio_.empty() ? nullptr : inverseMassRatio_.data();  // w (computeFactors)
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const float di = increments[i];
       VecD delta = di * wallGradient_[i];
       const VecD* g = pairGradients_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++g) delta += (di + increments[*j]) * *g;
-      v_[i] -= inverseDt * delta;
+      v_[i] -= (inverse ? inverseDt * inverse[i] : inverseDt) * delta;
       walls_.boundVelocity(x_[i], v_[i], dt);
       total[i] += di;
     }
@@ -243,8 +252,8 @@ int DfsphSolver<Dim>::solve(bool density, float dt, double limit, int minimum, s
   return corrections;
 }
 
-// Each collider's share of lambda_i G_i moved particle i's velocity by -(1 / dt) lambda_i V grad W_c: the
-// impulse m times that, from the collider.
+// Each collider's share of lambda_i G_i moved particle i's velocity by -(w_i / dt) lambda_i V grad W_c: the
+// impulse m_i times that, from the collider (m_i w_i = m_0, so the same with several fluids).
 template <int Dim>
 void DfsphSolver<Dim>::recordColliderImpulses(const std::vector<float>& lambda, float dt) {
   const float scale = -mass_ * volume_ / dt;

@@ -65,7 +65,7 @@ class DfsphSolver final : public ParticleSolver<Dim> {
  private:
   using Core = ParticleSolver<Dim>;
   using Core::x_, Core::v_, Core::neighbors_, Core::walls_, Core::colliders_, Core::mass_, Core::times_;
-  using Core::restDensity_, Core::vectorScratch_, Core::floatScratch_;
+  using Core::restDensity_, Core::vectorScratch_, Core::floatScratch_, Core::inverseMassRatio_;
 
   void resizeChannels(size_t n) override;
   // The two solvers' lambda totals, particle by particle.
@@ -76,7 +76,7 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   // Sorts the particles into the grid (reordering every channel) and computes, at the current positions, the
   // neighbour lists, each pair's g_ij, each particle's wall gradient G_i, density ratio and S_i.
   void prepareStep();
-  template <typename Kernel>
+  template <bool kSeveral, typename Kernel>
   void computeFactors(const Kernel& kernel);
   void applyNonPressureForces(float dt, double time);
   // One of the two solvers (Algorithms 2 and 3): iterates on v_ until the average residual is at most `limit`

@@ -90,7 +90,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     });
     if (this->tension_.active()) this->tension_.addWork(v_, dt);  // at the half step's velocities
     if (colliding) colliders_.addWrenches(colliderForces_, 0.5 * dt);
-    driftAgainstSolids(x_, v_, dt, mass_, colliders_, walls_);
+    driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_);
     if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
     computeAccelerations(time + dt);
     parallelFor(0, size(), [&](size_t b, size_t e) {
@@ -105,7 +105,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     });
     if (this->tension_.active()) this->tension_.addWork(v_, dt);
     if (colliding) colliders_.addWrenches(colliderForces_, dt);
-    driftAgainstSolids(x_, v_, dt, mass_, colliders_, walls_);
+    driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_);
     if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
     accelerationsValid_ = false;
   }
@@ -134,6 +134,13 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
   std::optional<PhaseTimer> timer(std::in_place, times_.pressure);
   const float selfWeight = kernel.value(0.0f);
   const bool near = nearStiffness_ > 0;
+  // Several fluids (Solenthaler and Pajarola 2008): density_ is m_0 times the number density, the same for every
+  // fluid at rest, and each fluid's pressure is its rest density's (rho_f / rho_0 = the mass ratio m_f / m_0).
+  // Eq. 8's a_i = -(1 / m_i) sum_j (p_i / delta_i^2 + p_j / delta_j^2) grad W_ij is then m_0 / m_i times the
+  // one fluid's sum; the viscous and near-pressure forces are weighted so that each pair's forces stay opposite.
+  const bool several = !massRatio_.empty();
+  const float* massRatio = massRatio_.data();
+  const float* inverse = inverseMassRatio_.data();
   const float inverseSupport = 1.0f / support_;
   // Density by summation and the equation of state.
   parallelFor(0, size(), [&](size_t b, size_t e) {
@@ -152,7 +159,8 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
       if (!colliders_.empty()) colliders_.add(x_[i], weight, unusedGradient);
       density_[i] = mass_ * weight;
       const float ratio = density_[i] / restDensity_;
-      const float p = tait_ ? taitB_ * (std::pow(ratio, 7.0f) - 1.0f) : gasConstant_ * (density_[i] - restDensity_);
+      float p = tait_ ? taitB_ * (std::pow(ratio, 7.0f) - 1.0f) : gasConstant_ * (density_[i] - restDensity_);
+      if (several) p *= massRatio[i];  // the fluid's own rest density in the equation of state
       pressure_[i] = std::max(p, 0.0f);
       if (near) nearPressure_[i] = nearStiffness_ * nearDensity;
     }
@@ -176,14 +184,17 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
         pressureForce -= (pressureTermI + pressure_[*j] / (density_[*j] * density_[*j])) * gradient;
         const VecD vij = v_[i] - v_[*j];
         const float mu = vij.dot(r) / (length * length + eta2);
+        // With several fluids m_j / m_i times a pair's mean mass over m_0 (2 m_j / (m_i + m_j)), so that
+        // m_i a_ij = -m_j a_ji.
+        const float pairMass = several ? 2.0f * massRatio[*j] / (massRatio[i] + massRatio[*j]) : 1.0f;
         if (alpha_ > 0 && mu < 0) {
           const float meanDensity = 0.5f * (density_[i] + density_[*j]);
-          viscousForce += (alpha_ * speedOfSound_ * h * mu / meanDensity) * gradient;
+          viscousForce += (pairMass * alpha_ * speedOfSound_ * h * mu / meanDensity) * gradient;
         }
-        if (nu_ > 0) viscousForce += (laminar * mu / density_[*j]) * gradient;
+        if (nu_ > 0) viscousForce += (pairMass * laminar * mu / density_[*j]) * gradient;
         if (near && length > 1e-12f) {
           const float d = std::max(1.0f - length * inverseSupport, 0.0f);
-          nearForce += ((nearPressure_[i] + nearPressure_[*j]) * d * d * inverseSupport / length) * r;
+          nearForce += (pairMass * (nearPressure_[i] + nearPressure_[*j]) * d * d * inverseSupport / length) * r;
         }
       }
       // The walls as mirrored particles with this particle's pressure continued hydrostatically, as the
@@ -191,8 +202,9 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
       float unusedWeight = 0;
       VecD wallGradient = VecD::Zero();
       walls_.add(x_[i], unusedWeight, wallGradient);
-      pressureForce -= 2.0f * pressureTermI * wallGradient +
-                       (1.0f / density_[i]) * walls_.hydrostaticSum(x_[i], gravity_);
+      // The walls' pressure continued at the particle's own density, m_i / m_0 times density_.
+      const float hydrostaticScale = (several ? massRatio[i] : 1.0f) / density_[i];
+      pressureForce -= 2.0f * pressureTermI * wallGradient + hydrostaticScale * walls_.hydrostaticSum(x_[i], gravity_);
       // The colliders likewise, their pressure continued hydrostatically (Colliders::hydrostaticSum); each
       // one's share is a force on the particle, recorded for colliders.csv.
       if (!colliders_.empty())
@@ -201,11 +213,13 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
           VecD gradient;
           colliders_.wallTerms(c, x_[i], d, n, unused, gradient);
           const VecD force = -2.0f * pressureTermI * gradient -
-                             (1.0f / density_[i]) * colliders_.hydrostaticSum(c, x_[i], d, n, gravity_);
+                             hydrostaticScale * colliders_.hydrostaticSum(c, x_[i], d, n, gravity_);
           pressureForce += force;
           colliders_.addImpulse(i, c, (mass_ * mass_) * force, x_[i]);
         });
-      VecD acceleration = gravity_ + mass_ * (pressureForce + viscousForce) + nearForce;
+      // m_0 (the pair sums) over m_i: the impulse on a collider, m_i times its share, is m_0^2 force either way.
+      const float massScale = several ? mass_ * inverse[i] : mass_;
+      VecD acceleration = gravity_ + massScale * (pressureForce + viscousForce) + (several ? inverse[i] : 1.0f) * nearForce;
       if (attractor_.active()) acceleration += attractor_.acceleration(x_[i], attractorAt);
       a_[i] = acceleration;
     }

@@ -54,7 +54,7 @@ class WcsphSolver final : public ParticleSolver<Dim> {
  private:
   using Core = ParticleSolver<Dim>;
   using Core::x_, Core::v_, Core::neighbors_, Core::walls_, Core::colliders_, Core::mass_, Core::times_;
-  using Core::restDensity_, Core::gravity_, Core::attractor_;
+  using Core::restDensity_, Core::gravity_, Core::attractor_, Core::massRatio_, Core::inverseMassRatio_;
 
   void resizeChannels(size_t n) override;
   void computeAccelerations(double time);

@@ -21,14 +21,8 @@ using testing::unitTankScene;
 // the water absorbs nothing. Whatever a path meets, the light it brings back is then exactly 1 in
 // expectation; more would mean energy created, less energy lost (within max_depth, made large here).
 Shading whiteFurnace(const Scene& scene) {
-  Shading s = Shading::fromScene(scene);
-  s.skyZenith = s.skyHorizon = s.belowHorizon = Eigen::Vector3f::Ones();
-  s.sunColor = Eigen::Vector3f::Zero();
-  s.sunGlow = 0;
-  s.floorAlbedo = s.groundAlbedo = s.tankAlbedo = 1;
-  s.checkerContrast = 0;
+  Shading s = testing::furnaceLight(scene);
   s.waterAbsorption = Eigen::Vector3f::Zero();
-  s.hazeDistance = std::numeric_limits<float>::infinity();
   s.maxDepth = 256;
   return s;
 }

@@ -5,12 +5,14 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "core/ply.h"
 #include "core/progress.h"
 #include "core/scene.h"
 #include "render/image.h"
+#include "render/shading.h"
 
 namespace surge::testing {
 
@@ -119,5 +121,19 @@ class CountingProgress : public Progress {
   size_t total = 0, done = 0;
   bool finished = false;
 };
+
+// A white furnace's light: the sky is 1 in every direction, there is no sun, and every diffuse surface has albedo
+// 1, so that whatever a path meets, the light it brings back is 1 in expectation less what the liquids absorb
+// (the scene's; waterAbsorption and fluidAbsorption, which a test may zero).
+inline Shading furnaceLight(const Scene& scene) {
+  Shading s = Shading::fromScene(scene);
+  s.skyZenith = s.skyHorizon = s.belowHorizon = Eigen::Vector3f::Ones();
+  s.sunColor = Eigen::Vector3f::Zero();
+  s.sunGlow = 0;
+  s.floorAlbedo = s.groundAlbedo = s.tankAlbedo = 1;
+  s.checkerContrast = 0;
+  s.hazeDistance = std::numeric_limits<float>::infinity();
+  return s;
+}
 
 }  // namespace surge::testing

@@ -24,7 +24,7 @@ class BallisticSolver final : public ParticleSolver<Dim> {
   long step(float dt, double time) override {
     const auto external = this->externalForces(dt, time);
     for (size_t i = 0; i < this->size(); ++i) external.kick(this->x_[i], this->v_[i]);
-    driftAgainstSolids(this->x_, this->v_, dt, this->mass_, this->colliders_, this->walls_);
+    driftAgainstSolids(this->x_, this->v_, dt, this->mass_, this->massRatio_, this->colliders_, this->walls_);
     return this->firstBadParticle();
   }
   FluidMeasures measure() override {

@@ -1,0 +1,93 @@
+// Rayleigh-Taylor (issue 34): a heavy fluid over a light one, their interface bent by one cosine mode, grows at
+// linear theory's rate sigma = sqrt(A g k tanh(k H)) (Chandrasekhar 1961, ch. X, for two layers of depth H
+// between walls, inviscid, no surface tension) within 20%, in DFSPH and WCSPH. PBF reads 0.60 to 0.84 of it
+// depending on its steps, and is not held to it (docs/several-fluids.md).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/scene.h"
+#include "sim/fluid_solver.h"
+#include "sim/simulation.h"
+
+namespace surge {
+namespace {
+
+// One wavelength across a tank 0.2 m wide at spacing 5 mm (40 particles a wavelength); each layer 0.1 m deep
+// (k H = pi: tanh(k H) = 0.996). Water (1000 kg/m^3) below, 3000 above: Atwood number 0.5. The amplitude is a
+// spacing less a fifth: the fluids are told apart on the lattice, so a smaller bend would not show.
+constexpr double kWidth = 0.2, kDepth = 0.1, kAmplitude = 0.004, kAtwood = 0.5;
+const double kWavenumber = 2 * M_PI / kWidth;
+
+// The amplitude of the interface's cosine mode from the heavy particles' positions: the heavy fluid fills
+// y > H + a cos(k x), so sum_heavy cos(k x_i) dx^2 = -a W / 2 (W the width) as long as its top stays flat.
+double modeAmplitude(const FluidSolver<2>& solver, double spacing) {
+  double sum = 0;
+  for (size_t i = 0; i < solver.size(); ++i)
+    if (solver.massRatios()[i] > 1.5f) sum += std::cos(kWavenumber * solver.positions()[i].x());
+  return -2.0 * spacing * spacing * sum / kWidth;
+}
+
+// Runs the instability for at most 0.3 s, sampling the mode's amplitude every 1/120 s, and fits sigma to
+// a(t) = a0 cosh(sigma t), the linear solution from rest, over the samples with k a < 0.5 (a < 0.08 wavelengths,
+// before the spikes form).
+double growthRate(const std::string& method) {
+  const std::string json = R"({"name": "rt", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.2, 0.3]},
+    "particle_spacing": 0.005,
+    "fluids": [{"box": {"min": [0, 0], "max": [0.2, 0.1]}},
+               {"name": "heavy", "rest_density": 3000, "box": {"min": [0, 0.1], "max": [0.2, 0.2]}}],
+    "output": {"fps": 120, "frames": 36}})";
+  const Scene scene = parseScene(json, "test.json", {"solver.method=" + method});
+  ParticleFrame frame = initialParticles(scene);
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const Eigen::Vector3f& p = frame.position[i];
+    frame.fluid[i] = p.y() > kDepth + kAmplitude * std::cos(kWavenumber * p.x()) ? 1 : 0;
+  }
+  const std::unique_ptr<FluidSolver<2>> solver = makeFluidSolver<2>(scene);
+  solver->setParticles(frame);
+  const double a0 = modeAmplitude(*solver, scene.particle_spacing);
+  double time = 0, sumTT = 0, sumTX = 0;
+  const double frameTime = 1.0 / scene.output.fps;
+  for (int f = 1; f <= scene.output.frames; ++f) {
+    solver->beginFrame(time);
+    double remaining = frameTime;
+    while (remaining > 0) {  // as the frame loop steps (sim/simulation.cpp)
+      const int substeps = solver->fixedSubsteps();
+      const double count = substeps > 0 ? substeps : std::max(1.0, std::ceil(remaining / solver->stableTimeStep() - 1e-9));
+      const float dt = float(substeps > 0 ? frameTime / count : remaining / count);
+      const long bad = solver->step(dt, time);
+      if (bad >= 0) {
+        ADD_FAILURE() << method << " at t = " << time << ": particle " << bad << " at "
+                      << solver->positions()[bad].transpose() << " moving " << solver->velocities()[bad].transpose();
+        return 0;
+      }
+      time += dt;
+      remaining = count == 1 ? 0 : remaining - dt;
+      if (substeps > 0 && remaining < 0.5 * dt) remaining = 0;
+    }
+    const double a = modeAmplitude(*solver, scene.particle_spacing);
+    if (kWavenumber * a > 0.5) break;
+    if (a > a0) {  // sigma t = acosh(a / a0): least squares through the origin
+      const double x = std::acosh(a / a0);
+      sumTT += time * time;
+      sumTX += time * x;
+    }
+  }
+  return sumTT > 0 ? sumTX / sumTT : 0;
+}
+
+class RayleighTaylor : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(RayleighTaylor, OneModeGrowsAtTheLinearRate) {
+  const double theory = std::sqrt(kAtwood * 9.81 * kWavenumber * std::tanh(kWavenumber * kDepth));
+  const double sigma = growthRate(GetParam());
+  std::printf("%s: growth rate %.2f /s against sqrt(A g k) = %.2f /s (%.2f)\n", GetParam().c_str(), sigma, theory,
+              sigma / theory);
+  EXPECT_NEAR(sigma, theory, 0.2 * theory);
+}
+
+INSTANTIATE_TEST_SUITE_P(Methods, RayleighTaylor, ::testing::Values("dfsph", "wcsph"));
+
+}  // namespace
+}  // namespace surge
