@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   addVideoCommand(app);
   addKeysCommand(app);
   addStudyCommand(app);
+  addExportCommand(app);
   installInterruptHandler();
   try {
     app.parse(argc, argv);
