@@ -40,5 +40,6 @@ ExportRun surveyRun(const fs::path& dir, const FrameRange& range, const CommonOp
 // Each writes under run.dir/export, every file to a temporary name and renamed, the series files last, and
 // returns the paths it wrote.
 std::vector<fs::path> exportVtk(const ExportRun& run, Progress& progress);
+std::vector<fs::path> exportUsd(const ExportRun& run, Progress& progress);
 
 }  // namespace surge

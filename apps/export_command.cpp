@@ -80,13 +80,15 @@ void addExportCommand(CLI::App& app) {
   addCommonOptions(*command, options->common, false);
   command->callback([options] {
     const auto start = std::chrono::steady_clock::now();
-    if (options->format != "vtk") throw InputError("--format", "'" + options->format + "' is not one of vtk");
+    if (options->format != "vtk" && options->format != "usd")
+      throw InputError("--format", "'" + options->format + "' is not one of vtk, usd");
     const FrameRange range = options->frames.empty() ? FrameRange{} : FrameRange::parse(options->frames);
     ThreadLimit threads(options->common.threads);
     const ExportRun run = surveyRun(options->dir, range, options->common);
     checkOutputFolder(run.dir / "export");
     TerminalProgress progress(!options->common.quiet);
-    const std::vector<fs::path> written = exportVtk(run, progress);
+    const std::vector<fs::path> written =
+        options->format == "vtk" ? exportVtk(run, progress) : exportUsd(run, progress);
     double bytes = 0;
     std::error_code error;
     for (const fs::path& path : written) bytes += double(fs::file_size(path, error));

@@ -9,10 +9,8 @@ nothing. Exit 77 (ctest's skip) where python3-vtk9 or numpy is missing.
 
 Usage: export_vtk_test.py SURGE_BINARY WORK_FOLDER
 """
-import json
 import os
 import shutil
-import subprocess
 import sys
 import xml.etree.ElementTree as ElementTree
 
@@ -20,67 +18,13 @@ try:
     import numpy as np
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy
+
+    from export_runs import SCENE, Checks, frame_ply, make_run, read_ply, surge
 except ImportError as missing:
     print(f"SKIP: {missing.name} is not installed (Debian python3-vtk9 and python3-numpy; scripts/setup.sh)")
     sys.exit(77)
 
-SCENE = {
-    "name": "export_check", "dimensions": 3,
-    "domain": {"min": [0, 0, 0], "max": [0.6, 0.5, 0.4]},
-    "particle_spacing": 0.025,
-    "fluids": [{"box": {"min": [0, 0, 0], "max": [0.3, 0.25, 0.4]}}],
-    "colliders": [
-        {"name": "post", "shape": "cylinder", "position": [0.5, 0.15, 0.2], "radius": 0.04, "height": 0.3},
-        {"name": "paddle", "shape": "box", "size": [0.03, 0.2, 0.3], "position": [0.4, 0.2, 0.2],
-         "motion": [{"time": 0.0, "position": [0.4, 0.2, 0.2]},
-                    {"time": 0.2, "position": [0.45, 0.2, 0.2], "rotation": {"axis": [0, 1, 0], "degrees": 20}}]}],
-    "bodies": [{"name": "crate", "shape": "box", "position": [0.15, 0.38, 0.2], "size": [0.08, 0.05, 0.08],
-                "density": 400}],
-    "surface": {"mesh_velocity": 1},
-    "output": {"fps": 25, "frames": 5},
-}
-
-failures = []
-
-
-def check(condition, what):
-    if not condition:
-        failures.append(what)
-        print("FAIL:", what)
-
-
-def read_ply(path):
-    """The vertex properties of a binary little-endian PLY as numpy columns, and its faces (a list of arrays)."""
-    with open(path, "rb") as f:
-        header = []
-        while True:
-            line = f.readline().decode("ascii").strip()
-            header.append(line)
-            if line == "end_header":
-                break
-        body = f.read()
-    types = {"float": "<f4", "uint": "<u4", "uchar": "u1", "int": "<i4", "double": "<f8"}
-    elements, current = [], None
-    for line in header:
-        words = line.split()
-        if words[0] == "element":
-            current = [words[1], int(words[2]), []]
-            elements.append(current)
-        elif words[0] == "property":
-            current[2].append((words[-1], words[1:-1]))
-    columns, faces, at = {}, [], 0
-    for name, count, properties in elements:
-        if name == "vertex":
-            dtype = np.dtype([(p, types[t[0]]) for p, t in properties])
-            records = np.frombuffer(body, dtype=dtype, count=count, offset=at)
-            at += dtype.itemsize * count
-            columns = {p: records[p] for p, _ in properties}
-        elif name == "face":
-            for _ in range(count):
-                n = body[at]
-                faces.append(np.frombuffer(body, dtype="<u4", count=n, offset=at + 1))
-                at += 1 + 4 * n
-    return columns, faces
+check = Checks()
 
 
 def read_vtp(path):
@@ -100,23 +44,9 @@ def read_pvd(path):
             for d in root.iter("DataSet")]
 
 
-def surge(binary, *arguments):
-    return subprocess.run([binary, *arguments, "--quiet"], capture_output=True, text=True)
-
-
 def main():
     binary, work = sys.argv[1], os.path.join(sys.argv[2], "export_vtk_test")
-    shutil.rmtree(work, ignore_errors=True)
-    os.makedirs(work)
-    scene_path = os.path.join(work, "scene.json")
-    with open(scene_path, "w") as f:
-        json.dump(SCENE, f)
-    run = os.path.join(work, "run")
-    for step in (["sim", scene_path, "--out", run], ["surface", run]):
-        result = surge(binary, *step)
-        if result.returncode != 0:
-            print(f"surge {step[0]} failed: {result.stderr}")
-            return 1
+    run = make_run(binary, work)
 
     # Bad input: one line naming the flag or the folder, exit 2, nothing written.
     result = surge(binary, "export", run, "--format", "obj")
@@ -146,7 +76,7 @@ def main():
     check([t for t, _, _, _ in particles] == [f / fps for f in range(frames + 1)],
           f"particle time steps {[t for t, _, _, _ in particles]}")
     for frame, (_, _, _, vtp) in enumerate(particles):
-        ply, _ = read_ply(os.path.join(run, "particles", f"frame_{frame:05d}.ply"))
+        ply, _ = read_ply(frame_ply(run, "particles", frame))
         data = read_vtp(vtp)
         n = len(ply["x"])
         check(data.GetNumberOfPoints() == n and data.GetNumberOfVerts() == n,
@@ -166,7 +96,7 @@ def main():
     surfaces = read_pvd(os.path.join(export, "surface.pvd"))
     check(len(surfaces) == frames + 1, f"{len(surfaces)} surface frames")
     for frame, (time, _, _, vtp) in enumerate(surfaces):
-        ply, faces = read_ply(os.path.join(run, "surface", f"frame_{frame:05d}.ply"))
+        ply, faces = read_ply(frame_ply(run, "surface", frame))
         data = read_vtp(vtp)
         check(time == frame / fps, f"surface frame {frame} at {time}")
         check(data.GetNumberOfPoints() == len(ply["x"]) and data.GetNumberOfPolys() == len(faces),
@@ -189,7 +119,7 @@ def main():
     for time, _, name, vtp in colliders:
         frame = round(time * fps)
         moving = name == "paddle"
-        source = os.path.join(run, "colliders", name, f"frame_{frame:05d}.ply") if moving else \
+        source = frame_ply(run, "colliders", frame, name) if moving else \
             os.path.join(run, "colliders", name + ".ply")
         ply, faces = read_ply(source)
         points = vtk_to_numpy(read_vtp(vtp).GetPoints().GetData())
@@ -203,14 +133,13 @@ def main():
           "body entries")
     for time, _, name, vtp in bodies:
         frame = round(time * fps)
-        ply, faces = read_ply(os.path.join(run, "bodies", name, f"frame_{frame:05d}.ply"))
+        ply, faces = read_ply(frame_ply(run, "bodies", frame, name))
         data = read_vtp(vtp)
         check(data.GetNumberOfPolys() == 12, f"crate at frame {frame}: {data.GetNumberOfPolys()} triangles")
         check(np.array_equal(vtk_to_numpy(data.GetPoints().GetData()),
                              np.stack([ply["x"], ply["y"], ply["z"]], axis=1)), f"crate at frame {frame}")
 
-    print(f"{'FAILED' if failures else 'passed'}: {len(failures)} failures")
-    return 1 if failures else 0
+    return check.status()
 
 
 if __name__ == "__main__":
