@@ -209,28 +209,20 @@ struct SolidPose {
 
 // Each body's pose at each frame from bodies.csv: its centre of mass and orientation.
 std::map<std::string, std::map<int, SolidPose>> readBodyPoses(const fs::path& path) {
-  const std::string text = readTextFile(path);
+  const CsvTable table = readCsvTable(path);
+  std::vector<int> columns;
+  for (const char* name : {"frame", "body", "x", "y", "z", "qw", "qx", "qy", "qz"}) {
+    columns.push_back(table.column(name));
+    if (columns.back() < 0) throw InputError(path.string(), name, "column missing");
+  }
   std::map<std::string, std::map<int, SolidPose>> poses;
-  size_t at = 0;
-  std::vector<std::string> header;
-  std::map<std::string, int> column;
-  while (at < text.size()) {
-    const size_t end = std::min(text.find('\n', at), text.size());
-    const std::vector<std::string> fields = splitCsvLine(text.substr(at, end - at));
-    at = end + 1;
-    if (header.empty()) {
-      header = fields;
-      for (size_t c = 0; c < header.size(); ++c) column[header[c]] = int(c);
-      for (const char* name : {"frame", "body", "x", "y", "z", "qw", "qx", "qy", "qz"})
-        if (!column.count(name)) throw InputError(path.string(), name, "column missing");
-      continue;
-    }
-    if (fields.size() != header.size()) continue;  // a row cut short by a killed run
-    auto value = [&](const char* name) { return std::atof(fields[size_t(column[name])].c_str()); };
+  for (const std::vector<std::string>& row : table.rows) {
+    double v[9];
+    for (int k = 0; k < 9; ++k) v[k] = k == 1 ? 0 : std::atof(row[size_t(columns[size_t(k)])].c_str());
     SolidPose pose;
-    pose.translation = Eigen::Vector3d(value("x"), value("y"), value("z"));
-    pose.rotation = Eigen::Quaterniond(value("qw"), value("qx"), value("qy"), value("qz")).normalized();
-    poses[fields[size_t(column["body"])]][std::atoi(fields[size_t(column["frame"])].c_str())] = pose;
+    pose.translation = Eigen::Vector3d(v[2], v[3], v[4]);
+    pose.rotation = Eigen::Quaterniond(v[5], v[6], v[7], v[8]).normalized();
+    poses[row[size_t(columns[1])]][int(v[0])] = pose;
   }
   return poses;
 }

@@ -168,18 +168,6 @@ void writeMeshFrame(const fs::path& ply, const fs::path& vtp) {
   writePolyData(vtp, n, 0, mesh.triangles.size(), arrays);
 }
 
-std::string xmlAttribute(const std::string& text) {
-  std::string escaped;
-  for (char c : text) {
-    if (c == '&') escaped += "&amp;";
-    else if (c == '<') escaped += "&lt;";
-    else if (c == '>') escaped += "&gt;";
-    else if (c == '"') escaped += "&quot;";
-    else escaped += c;
-  }
-  return escaped;
-}
-
 // One entry of a .pvd: a time step's file (relative to the .pvd), and its part and name where a time step
 // holds several (one a collider).
 struct PvdEntry {
@@ -197,8 +185,8 @@ void writePvd(const fs::path& path, const std::vector<PvdEntry>& entries) {
       char time[32];
       *std::to_chars(time, time + sizeof time - 1, e.time).ptr = '\0';  // the shortest text that reads back exactly
       out << "    <DataSet timestep=\"" << time << "\" part=\"" << e.part << "\"";
-      if (!e.name.empty()) out << " name=\"" << xmlAttribute(e.name) << "\"";
-      out << " file=\"" << xmlAttribute(e.file.generic_string()) << "\"/>\n";
+      if (!e.name.empty()) out << " name=\"" << escapeXml(e.name) << "\"";
+      out << " file=\"" << escapeXml(e.file.generic_string()) << "\"/>\n";
     }
     out << "  </Collection>\n</VTKFile>\n";
   });

@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
   addKeysCommand(app);
   addStudyCommand(app);
   addExportCommand(app);
+  addReportCommand(app);
   installInterruptHandler();
   try {
     app.parse(argc, argv);

@@ -1,11 +1,26 @@
 """What the export tests share: a small 3D run to export (a standing and a keyframed collider, a body, a surface
 with velocities), its PLY files read with numpy, the surge binary run quietly, and a list of failed checks."""
+import importlib
 import json
 import os
 import shutil
 import subprocess
+import sys
 
-import numpy as np
+DEBIAN_PACKAGES = {"numpy": "python3-numpy", "vtk": "python3-vtk9"}
+
+
+def require(*names):
+    """The modules named, imported; where one is missing, exit 77 (ctest's skip) naming its Debian package."""
+    try:
+        return [importlib.import_module(name) for name in names]
+    except ImportError as missing:
+        top = (missing.name or "").split(".")[0]
+        print(f"SKIP: {top} is not installed (Debian {DEBIAN_PACKAGES.get(top, top)}; scripts/setup.sh)")
+        sys.exit(77)
+
+
+np, = require("numpy")
 
 SCENE = {
     "name": "export_check", "dimensions": 3,

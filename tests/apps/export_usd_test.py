@@ -20,13 +20,9 @@ import shutil
 import subprocess
 import sys
 
-try:
-    import numpy as np
+from export_runs import SCENE, Checks, frame_ply, make_run, read_ply, require, surge
 
-    from export_runs import SCENE, Checks, frame_ply, make_run, read_ply, surge
-except ImportError as missing:
-    print(f"SKIP: {missing.name} is not installed (Debian python3-numpy; scripts/setup.sh)")
-    sys.exit(77)
+np, = require("numpy")
 
 check = Checks()
 FRAMES, FPS = SCENE["output"]["frames"], SCENE["output"]["fps"]

@@ -14,15 +14,10 @@ import shutil
 import sys
 import xml.etree.ElementTree as ElementTree
 
-try:
-    import numpy as np
-    import vtk
-    from vtk.util.numpy_support import vtk_to_numpy
+from export_runs import SCENE, Checks, frame_ply, make_run, read_ply, require, surge
 
-    from export_runs import SCENE, Checks, frame_ply, make_run, read_ply, surge
-except ImportError as missing:
-    print(f"SKIP: {missing.name} is not installed (Debian python3-vtk9 and python3-numpy; scripts/setup.sh)")
-    sys.exit(77)
+np, vtk, numpy_support = require("numpy", "vtk", "vtk.util.numpy_support")
+vtk_to_numpy = numpy_support.vtk_to_numpy
 
 check = Checks()
 
