@@ -37,9 +37,9 @@ ExportRun surveyRun(const fs::path& dir, const FrameRange& range, const CommonOp
   run.scene = sceneOfFolder(dir, options);
   run.frames = framesInRange(dir, "particles", range);
   if (run.frames.empty())
-    throw InputError((dir / "particles").string(),
-                     listFrames(dir, "particles", "ply").empty() ? "no particle frames: run surge sim first"
-                                                                  : "no particle frames in --frames");
+    throw InputError((dir / "particles").string(), listFrames(dir, "particles", "ply").empty()
+                                                       ? "no particle frames: run surge sim first"
+                                                       : "no particle frames in --frames");
   run.series.push_back({"particles", false, run.frames});
   const std::vector<int> whitewater = framesInRange(dir, "whitewater", range);
   if (!whitewater.empty()) run.series.push_back({"whitewater", false, whitewater});

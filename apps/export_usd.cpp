@@ -128,24 +128,34 @@ void appendTopology(std::string& counts, std::string& indices, const TriangleMes
   indices += ']';
 }
 
-// What every point-based prim samples: positions, and velocities where the frames have them.
+// What a point-based prim samples: positions, and velocities and ids where the frames have them.
 struct PointSamples {
   std::vector<Eigen::Vector3f> position, velocity;
+  std::vector<uint32_t> id;
 };
 
-// points, extent and (when the first frame has them) velocities, sampled from samplesOf(frame).
+// points, extent, and (when the first frame has them) velocities and ids, sampled from samplesOf(frame); four
+// progress steps a frame.
 void writePointSamples(std::ostream& out, const std::vector<int>& frames,
                        const std::function<PointSamples(int)>& samplesOf, Progress& progress) {
-  writeTimeSamples(out, "point3f[] points", frames, [&](int f, std::string& text) {
-    appendVectors(text, samplesOf(f).position);
-  }, progress);
-  writeTimeSamples(out, "float3[] extent", frames, [&](int f, std::string& text) {
-    appendExtent(text, samplesOf(f).position);
-  }, progress);
-  if (samplesOf(frames.front()).velocity.empty()) return progress.advance(frames.size());
-  writeTimeSamples(out, "vector3f[] velocities", frames, [&](int f, std::string& text) {
-    appendVectors(text, samplesOf(f).velocity);
-  }, progress);
+  const PointSamples first = samplesOf(frames.front());
+  writeTimeSamples(
+      out, "point3f[] points", frames, [&](int f, std::string& text) { appendVectors(text, samplesOf(f).position); },
+      progress);
+  writeTimeSamples(
+      out, "float3[] extent", frames, [&](int f, std::string& text) { appendExtent(text, samplesOf(f).position); },
+      progress);
+  if (first.velocity.empty())
+    progress.advance(frames.size());
+  else
+    writeTimeSamples(
+        out, "vector3f[] velocities", frames,
+        [&](int f, std::string& text) { appendVectors(text, samplesOf(f).velocity); }, progress);
+  if (first.id.empty())
+    progress.advance(frames.size());
+  else
+    writeTimeSamples(
+        out, "int64[] ids", frames, [&](int f, std::string& text) { appendIntegers(text, samplesOf(f).id); }, progress);
 }
 
 // A fluid surface series: points, topology, extent and (where its meshes carry them) velocities, all sampled.
@@ -154,50 +164,47 @@ void writeSurface(std::ostream& out, const ExportRun& run, const FrameSeries& se
   TriangleMesh first;
   for (int f : series.frames)
     if (!(first = mesh(f)).triangles.empty()) break;
+  std::string color;
+  appendTuple(color, run.scene.render.water_color);
   out << "    def Mesh \"" << primName(series.kind) << "\"\n    {\n"
       << "        uniform token subdivisionScheme = \"none\"\n"
-      << "        uniform token orientation = \"" << orientation(first) << "\"\n";
-  const Eigen::Vector3d color = run.scene.render.water_color;
-  std::string colorText;
-  appendTuple(colorText, color);
-  out << "        color3f[] primvars:displayColor = [" << colorText << "]\n";
-  writePointSamples(out, series.frames, [&](int f) {
+      << "        uniform token orientation = \"" << orientation(first) << "\"\n"
+      << "        color3f[] primvars:displayColor = [" << color << "]\n";
+  auto samples = [&](int f) {
     TriangleMesh m = mesh(f);
-    return PointSamples{std::move(m.positions), std::move(m.velocities)};
-  }, progress);
-  writeTimeSamples(out, "int[] faceVertexCounts", series.frames, [&](int f, std::string& text) {
-    std::string indices;
-    appendTopology(text, indices, mesh(f));
-  }, progress);
-  writeTimeSamples(out, "int[] faceVertexIndices", series.frames, [&](int f, std::string& text) {
-    std::string counts;
-    appendTopology(counts, text, mesh(f));
-  }, progress);
+    return PointSamples{std::move(m.positions), std::move(m.velocities), {}};
+  };
+  writePointSamples(out, series.frames, samples, progress);
+  for (const bool counts : {true, false}) {
+    auto topology = [&](int f, std::string& text) {
+      std::string other;
+      if (counts)
+        appendTopology(text, other, mesh(f));
+      else
+        appendTopology(other, text, mesh(f));
+    };
+    writeTimeSamples(out, counts ? "int[] faceVertexCounts" : "int[] faceVertexIndices", series.frames, topology,
+                     progress);
+  }
   out << "    }\n";
 }
 
 // Particles (or whitewater) as Points: points, extent, velocities and ids sampled, one width (the spacing).
 void writePoints(std::ostream& out, const ExportRun& run, const FrameSeries& series, Progress& progress) {
-  out << "    def Points \"" << primName(series.kind) << "\"\n    {\n"
-      << "        float[] widths = [";
   std::string width;
   appendNumber(width, float(run.scene.particle_spacing));
-  out << width << "] (interpolation = \"constant\")\n";
-  auto frame = [&](int f) {
+  out << "    def Points \"" << primName(series.kind) << "\"\n    {\n"
+      << "        float[] widths = [" << width << "] (interpolation = \"constant\")\n";
+  auto samples = [&](int f) {
     const fs::path path = framePath(run.dir, series.kind, f, "ply");
-    if (series.kind == "particles") return readParticlePly(path);
-    const DiffuseFrame diffuse = readDiffusePly(path);
-    ParticleFrame points;
-    points.position = diffuse.position, points.velocity = diffuse.velocity, points.id = diffuse.id;
-    return points;
+    if (series.kind == "particles") {
+      ParticleFrame frame = readParticlePly(path);
+      return PointSamples{std::move(frame.position), std::move(frame.velocity), std::move(frame.id)};
+    }
+    DiffuseFrame frame = readDiffusePly(path);
+    return PointSamples{std::move(frame.position), std::move(frame.velocity), std::move(frame.id)};
   };
-  writePointSamples(out, series.frames, [&](int f) {
-    ParticleFrame points = frame(f);
-    return PointSamples{std::move(points.position), std::move(points.velocity)};
-  }, progress);
-  writeTimeSamples(out, "int64[] ids", series.frames, [&](int f, std::string& text) {
-    appendIntegers(text, frame(f).id);
-  }, progress);
+  writePointSamples(out, series.frames, samples, progress);
   out << "    }\n";
 }
 
@@ -229,13 +236,12 @@ std::map<std::string, std::map<int, SolidPose>> readBodyPoses(const fs::path& pa
 
 // A collider or body: its frame-0 mesh taken into its own frame (pose at frame 0 undone) and, when it moves,
 // its pose at every frame as translate and orient samples; a standing one stays in the world.
-void writeSolid(std::ostream& out, const ExportRun& run, const SolidFiles& solid,
-                const std::map<int, SolidPose>& poses, Progress& progress) {
+void writeSolid(std::ostream& out, const ExportRun& run, const SolidFiles& solid, const std::map<int, SolidPose>& poses,
+                Progress& progress) {
   TriangleMesh mesh = readMeshPly(run.dir / solid.folder / (solid.settings.name + ".ply"));
   const bool moving = !poses.empty();
   if (moving) {
-    if (!poses.count(0))
-      throw InputError((run.dir / "bodies.csv").string(), solid.settings.name, "no row at frame 0");
+    if (!poses.count(0)) throw InputError((run.dir / "bodies.csv").string(), solid.settings.name, "no row at frame 0");
     const SolidPose& start = poses.at(0);
     for (Eigen::Vector3f& p : mesh.positions)
       p = (start.rotation.conjugate() * (p.cast<double>() - start.translation)).cast<float>();
@@ -265,8 +271,10 @@ void writeSolid(std::ostream& out, const ExportRun& run, const SolidFiles& solid
       appendTuple(orient, Eigen::Vector4f(q.w(), q.x(), q.y(), q.z()));
       orient += ",\n";
     }
-    out << "            double3 xformOp:translate.timeSamples = {\n" << translate << "            }\n"
-        << "            quatf xformOp:orient.timeSamples = {\n" << orient << "            }\n"
+    out << "            double3 xformOp:translate.timeSamples = {\n"
+        << translate << "            }\n"
+        << "            quatf xformOp:orient.timeSamples = {\n"
+        << orient << "            }\n"
         << "            uniform token[] xformOpOrder = [\"xformOp:translate\", \"xformOp:orient\"]\n";
   }
   out << "        }\n";
@@ -278,7 +286,7 @@ void writeSolid(std::ostream& out, const ExportRun& run, const SolidFiles& solid
 std::vector<fs::path> exportUsd(const ExportRun& run, Progress& progress) {
   const fs::path path = run.dir / "export" / "scene.usda";
   size_t total = run.solids.size();
-  for (const FrameSeries& s : run.series) total += s.frames.size() * (s.mesh ? 5 : 4);
+  for (const FrameSeries& s : run.series) total += s.frames.size() * (s.mesh ? 6 : 4);
   progress.start("export usd", total);
   // The moving solids' poses: a body's from bodies.csv, a keyframed collider's from its motion.
   std::map<std::string, std::map<int, SolidPose>> bodyPoses;
@@ -294,8 +302,10 @@ std::vector<fs::path> exportUsd(const ExportRun& run, Progress& progress) {
     out << "    timeCodesPerSecond = " << fps << "\n    framesPerSecond = " << fps << "\n)\n\n"
         << "def Xform \"" << primName(run.scene.name) << "\"\n{\n";
     for (const FrameSeries& series : run.series) {
-      if (series.mesh) writeSurface(out, run, series, progress);
-      else writePoints(out, run, series, progress);
+      if (series.mesh)
+        writeSurface(out, run, series, progress);
+      else
+        writePoints(out, run, series, progress);
     }
     for (const std::string folder : {"colliders", "bodies"}) {
       bool opened = false;

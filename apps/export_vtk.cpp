@@ -84,17 +84,6 @@ void writePolyData(const fs::path& path, size_t points, size_t verts, size_t pol
   });
 }
 
-// The VTK type of a PLY property type (core/ply's names), with the bytes of `columns` interleaved in it.
-std::string vtkType(const std::string& plyType) {
-  static const std::map<std::string, std::string> types = {
-      {"char", "Int8"},     {"int8", "Int8"},      {"uchar", "UInt8"},  {"uint8", "UInt8"},     {"short", "Int16"},
-      {"int16", "Int16"},   {"ushort", "UInt16"},  {"uint16", "UInt16"}, {"int", "Int32"},      {"int32", "Int32"},
-      {"uint", "UInt32"},   {"uint32", "UInt32"},  {"float", "Float32"}, {"float32", "Float32"},
-      {"double", "Float64"}, {"float64", "Float64"}};
-  const auto it = types.find(plyType);
-  return it == types.end() ? "Float64" : it->second;
-}
-
 template <typename T>
 std::string interleave(const std::vector<const PlyColumn*>& columns) {
   const size_t n = columns.front()->values.size();
@@ -104,21 +93,34 @@ std::string interleave(const std::vector<const PlyColumn*>& columns) {
   return bytesOf(values.data(), values.size());
 }
 
+// A VTK data type: its name and the bytes of PLY columns interleaved in it.
+struct VtkType {
+  std::string name;
+  std::string (*interleave)(const std::vector<const PlyColumn*>&);
+};
+
+// The VTK type of a PLY property type (core/ply's names); Float64 for any other.
+const VtkType& vtkType(const std::string& plyType) {
+  static const VtkType int8{"Int8", interleave<int8_t>}, uint8{"UInt8", interleave<uint8_t>},
+      int16{"Int16", interleave<int16_t>}, uint16{"UInt16", interleave<uint16_t>}, int32{"Int32", interleave<int32_t>},
+      uint32{"UInt32", interleave<uint32_t>}, float32{"Float32", interleave<float>},
+      float64{"Float64", interleave<double>};
+  static const std::map<std::string, const VtkType*> types = {
+      {"char", &int8},     {"int8", &int8},       {"uchar", &uint8},    {"uint8", &uint8},
+      {"short", &int16},   {"int16", &int16},     {"ushort", &uint16},  {"uint16", &uint16},
+      {"int", &int32},     {"int32", &int32},     {"uint", &uint32},    {"uint32", &uint32},
+      {"float", &float32}, {"float32", &float32}, {"double", &float64}, {"float64", &float64}};
+  const auto it = types.find(plyType);
+  return it == types.end() ? float64 : *it->second;
+}
+
 // An array of one or three PLY columns, in their own type when they share one, else Float64.
-VtkArray columnArray(const std::string& section, const std::string& name, const std::vector<const PlyColumn*>& columns) {
-  std::string type = vtkType(columns.front()->type);
+VtkArray columnArray(const std::string& section, const std::string& name,
+                     const std::vector<const PlyColumn*>& columns) {
+  const VtkType* type = &vtkType(columns.front()->type);
   for (const PlyColumn* c : columns)
-    if (vtkType(c->type) != type) type = "Float64";
-  VtkArray array{section, name, type, int(columns.size()), {}};
-  if (type == "Int8") array.bytes = interleave<int8_t>(columns);
-  else if (type == "UInt8") array.bytes = interleave<uint8_t>(columns);
-  else if (type == "Int16") array.bytes = interleave<int16_t>(columns);
-  else if (type == "UInt16") array.bytes = interleave<uint16_t>(columns);
-  else if (type == "Int32") array.bytes = interleave<int32_t>(columns);
-  else if (type == "UInt32") array.bytes = interleave<uint32_t>(columns);
-  else if (type == "Float32") array.bytes = interleave<float>(columns);
-  else array.bytes = interleave<double>(columns);
-  return array;
+    if (vtkType(c->type).name != type->name) type = &vtkType("double");
+  return {section, name, type->name, int(columns.size()), type->interleave(columns)};
 }
 
 // A particle (or whitewater) frame: every vertex property, one vertex cell a particle.
@@ -199,8 +201,10 @@ void convertAll(const std::vector<std::pair<fs::path, fs::path>>& jobs, bool mes
       [&](size_t begin, size_t end) {
         for (size_t j = begin; j < end; ++j) {
           Progress::checkInterrupt();
-          if (mesh) writeMeshFrame(jobs[j].first, jobs[j].second);
-          else writePointsFrame(jobs[j].first, jobs[j].second);
+          if (mesh)
+            writeMeshFrame(jobs[j].first, jobs[j].second);
+          else
+            writePointsFrame(jobs[j].first, jobs[j].second);
           progress.advance();
         }
       },

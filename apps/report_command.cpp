@@ -29,7 +29,9 @@ std::string base64(const std::string& bytes) {
   return text;
 }
 
-double number(const std::string& field) { return field.empty() ? NAN : std::atof(field.c_str()); }
+double number(const std::string& field) {
+  return field.empty() ? NAN : std::atof(field.c_str());
+}
 
 // One column of a table as numbers, scaled; NaN where a row leaves it empty, all NaN where there is no column.
 std::vector<double> column(const CsvTable& table, const std::string& name, double scale = 1) {
@@ -111,30 +113,29 @@ std::string summary(const Scene& scene, const CsvTable& stats) {
 fs::path writeReport(const fs::path& dir, const Scene& scene) {
   std::error_code error;
   const fs::path statsPath = dir / "stats.csv";
-  if (!fs::exists(statsPath, error))
-    throw InputError(statsPath.string(), "missing: not an output folder of surge sim");
+  if (!fs::exists(statsPath, error)) throw InputError(statsPath.string(), "missing: not an output folder of surge sim");
   const CsvTable stats = readCsvTable(statsPath);
-  std::string html = "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>surge report: " +
-                     escapeXml(scene.name) +
-                     "</title>\n<style>body{font-family:sans-serif;margin:16px;background:#fff;color:#222}"
-                     ".plots{display:flex;flex-wrap:wrap;gap:8px}td{padding:1px 10px 1px 0}"
-                     "img,video{max-width:100%}</style></head>\n<body>\n<h1>" +
-                     escapeXml(scene.name) + "</h1>\n" + summary(scene, stats);
+  std::string html =
+      "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>surge report: " + escapeXml(scene.name) +
+      "</title>\n<style>body{font-family:sans-serif;margin:16px;background:#fff;color:#222}"
+      ".plots{display:flex;flex-wrap:wrap;gap:8px}td{padding:1px 10px 1px 0}"
+      "img,video{max-width:100%}</style></head>\n<body>\n<h1>" +
+      escapeXml(scene.name) + "</h1>\n" + summary(scene, stats);
   html += "<h2>Over time</h2>\n<div class=\"plots\" id=\"stats\">\n" + statsPlots(stats) + "</div>\n";
-  for (const auto& [file, key, title] : {std::tuple<const char*, const char*, const char*>{"bodies.csv", "body", "Bodies"},
-                                         {"colliders.csv", "collider", "Colliders"}}) {
+  for (const auto& [file, key, title] :
+       {std::tuple<const char*, const char*, const char*>{"bodies.csv", "body", "Bodies"},
+        {"colliders.csv", "collider", "Colliders"}}) {
     if (!fs::exists(dir / file, error)) continue;
     html += std::string("<h2>") + title + ": the fluid's force</h2>\n<div class=\"plots\">\n" +
             forcePlots(readCsvTable(dir / file), key, scene.output.fps) + "</div>\n";
   }
   // The contact sheet: made from frames/ when it is missing and there are frames to make it of.
   fs::path sheet = dir / (scene.name + "_contact_sheet.png");
-  if (!fs::exists(sheet, error) && !listFrames(dir, "frames", "png").empty())
-    sheet = makeContactSheet(dir, scene);
+  if (!fs::exists(sheet, error) && !listFrames(dir, "frames", "png").empty()) sheet = makeContactSheet(dir, scene);
   html += "<h2>Frames</h2>\n";
-  html += fs::exists(sheet, error) ? "<img alt=\"contact sheet\" src=\"data:image/png;base64," +
-                                         base64(readTextFile(sheet)) + "\">\n"
-                                   : "<p>No frames rendered (surge render DIR).</p>\n";
+  html += fs::exists(sheet, error)
+              ? "<img alt=\"contact sheet\" src=\"data:image/png;base64," + base64(readTextFile(sheet)) + "\">\n"
+              : "<p>No frames rendered (surge render DIR).</p>\n";
   const std::string video = scene.name + ".mp4";
   html += "<h2>Video</h2>\n";
   html += fs::exists(dir / video, error)

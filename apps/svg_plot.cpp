@@ -65,16 +65,18 @@ std::string svgLinePlot(const PlotLabels& labels, const std::vector<PlotSeries>&
       "font-family=\"sans-serif\" font-size=\"11\">\n",
       width, height, width, height);
   add("<rect width=\"%d\" height=\"%d\" fill=\"white\"/>\n", width, height);
-  svg += "<text x=\"" + number(left) + "\" y=\"18\" font-size=\"13\" font-weight=\"bold\">" +
-         escapeXml(labels.title) + "</text>\n";
+  svg += "<text x=\"" + number(left) + "\" y=\"18\" font-size=\"13\" font-weight=\"bold\">" + escapeXml(labels.title) +
+         "</text>\n";
   // Grid and ticks.
   for (double y = y0; y <= y1 + yStep * 1e-6; y += yStep) {
-    add("<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n", left, py(y), left + plotWidth, py(y));
+    add("<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n", left, py(y), left + plotWidth,
+        py(y));
     add("<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">", left - 4, py(y) + 4);
     svg += number(y) + "</text>\n";
   }
   for (double x = std::ceil(x0 / xStep) * xStep; x <= x1 + xStep * 1e-6; x += xStep) {
-    add("<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#eee\"/>\n", px(x), top, px(x), top + plotHeight);
+    add("<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#eee\"/>\n", px(x), top, px(x),
+        top + plotHeight);
     add("<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">", px(x), top + plotHeight + 14);
     svg += number(x) + "</text>\n";
   }
@@ -94,8 +96,8 @@ std::string svgLinePlot(const PlotLabels& labels, const std::vector<PlotSeries>&
     svg += "\"/>\n";
     if (series.size() < 2) continue;
     const double ly = top + 12 + 14 * double(s);
-    add("<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\" stroke-width=\"2\"/>", left + plotWidth - 140,
-        ly - 4, left + plotWidth - 122, ly - 4, color);
+    add("<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\" stroke-width=\"2\"/>",
+        left + plotWidth - 140, ly - 4, left + plotWidth - 122, ly - 4, color);
     add("<text x=\"%.1f\" y=\"%.1f\">", left + plotWidth - 118, ly);
     svg += escapeXml(series[s].name) + "</text>\n";
   }

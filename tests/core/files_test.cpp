@@ -67,7 +67,8 @@ TEST(Files, FrameRanges) {
 TEST(Files, CsvTablesByColumnName) {
   const fs::path dir = fs::path(testing::TempDir()) / "surge_csv_test";
   fs::create_directories(dir);
-  writeFileAtomically(dir / "bodies.csv", [](std::ostream& out) { out << "frame,body,x\n0,crate,0.5\n1,crate,0.25\n2,cra"; });
+  writeFileAtomically(dir / "bodies.csv",
+                      [](std::ostream& out) { out << "frame,body,x\n0,crate,0.5\n1,crate,0.25\n2,cra"; });
   const CsvTable table = readCsvTable(dir / "bodies.csv");
   ASSERT_EQ(table.rows.size(), 2u);
   EXPECT_EQ(table.column("x"), 2);
