@@ -38,6 +38,8 @@ void addRenderCommand(CLI::App& app);
 void addVideoCommand(CLI::App& app);
 void addKeysCommand(CLI::App& app);
 void addStudyCommand(CLI::App& app);
+void addExportCommand(CLI::App& app);
+void addReportCommand(CLI::App& app);
 
 // The stages, shared by their own subcommands and by `surge run`.
 // With `resume` (surge sim --resume, surge run --resume) each stage picks up where a stopped run left off: the

@@ -47,6 +47,8 @@ int main(int argc, char** argv) {
   addVideoCommand(app);
   addKeysCommand(app);
   addStudyCommand(app);
+  addExportCommand(app);
+  addReportCommand(app);
   installInterruptHandler();
   try {
     app.parse(argc, argv);

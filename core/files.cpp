@@ -149,6 +149,38 @@ std::vector<std::string> splitCsvLine(const std::string& line) {
   return fields;
 }
 
+int CsvTable::column(const std::string& name) const {
+  for (size_t c = 0; c < header.size(); ++c)
+    if (header[c] == name) return int(c);
+  return -1;
+}
+
+CsvTable readCsvTable(const fs::path& path) {
+  std::istringstream lines(readTextFile(path));
+  CsvTable table;
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.empty()) continue;
+    std::vector<std::string> fields = splitCsvLine(line);
+    if (table.header.empty()) table.header = std::move(fields);
+    else if (fields.size() == table.header.size()) table.rows.push_back(std::move(fields));
+  }
+  if (table.header.empty()) throw InputError(path.string(), "empty: no header line");
+  return table;
+}
+
+std::string escapeXml(const std::string& text) {
+  std::string escaped;
+  for (char c : text) {
+    if (c == '&') escaped += "&amp;";
+    else if (c == '<') escaped += "&lt;";
+    else if (c == '>') escaped += "&gt;";
+    else if (c == '"') escaped += "&quot;";
+    else escaped += c;
+  }
+  return escaped;
+}
+
 void checkOutputFolder(const fs::path& dir) {
   std::error_code error;
   if (fs::exists(dir, error) && !fs::is_directory(dir, error))

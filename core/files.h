@@ -64,5 +64,17 @@ void checkOutputFolder(const fs::path& dir);
 std::string readTextFile(const fs::path& path);
 // The fields of one line of the CSV files surge writes (no quoting: only study.csv quotes, and is not read).
 std::vector<std::string> splitCsvLine(const std::string& line);
+// A CSV file surge writes (stats.csv, bodies.csv, colliders.csv) by column name: its header and each row's fields;
+// a row of another field count (cut short by a killed run) is left out. Throws InputError naming the file when it
+// cannot be read or is empty.
+struct CsvTable {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  int column(const std::string& name) const;  // its index, or -1
+};
+CsvTable readCsvTable(const fs::path& path);
+
+// `text` with & < > " escaped, to stand in XML or HTML text or an attribute (the exporters' and the report's).
+std::string escapeXml(const std::string& text);
 
 }  // namespace surge

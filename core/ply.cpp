@@ -404,6 +404,20 @@ bool readDiffusePlyIfPresent(const fs::path& path, DiffuseFrame& frame) {
   return true;
 }
 
+std::vector<PlyColumn> readVertexColumns(const fs::path& path) {
+  const std::string where = path.string();
+  const PlyFile file = parsePly(path);
+  size_t index = 0;
+  if (!findElement(file, "vertex", &index)) throw InputError(where, "element vertex", "missing");
+  std::vector<std::string> names;
+  for (const PlyProperty& p : file.elements[index].properties) names.push_back(p.name);
+  auto values = readColumns(file, index, names, std::vector<bool>(names.size(), false), where);
+  std::vector<PlyColumn> columns(names.size());
+  for (size_t n = 0; n < names.size(); ++n)
+    columns[n] = {names[n], file.elements[index].properties[n].type, std::move(values[n])};
+  return columns;
+}
+
 void writeMeshPly(const fs::path& path, const TriangleMesh& mesh) {
   const bool normals = mesh.normals.size() == mesh.positions.size() && !mesh.positions.empty();
   const bool velocities = mesh.velocities.size() == mesh.positions.size() && !mesh.positions.empty();

@@ -64,6 +64,14 @@ DiffuseFrame readDiffusePly(const fs::path& path);
 // The later stages draw whatever whitewater/ holds: false, and `frame` untouched, where the file is absent.
 bool readDiffusePlyIfPresent(const fs::path& path, DiffuseFrame& frame);
 
+// Every scalar property of a PLY's `vertex` element in the file's order, its PLY type and its values, whatever
+// their names: for the exporters (surge export), which pass on every channel a frame holds.
+struct PlyColumn {
+  std::string name, type;  // type as the header spells it: float, uint, uchar...
+  std::vector<double> values;
+};
+std::vector<PlyColumn> readVertexColumns(const fs::path& path);
+
 void writeMeshPly(const fs::path& path, const TriangleMesh& mesh);
 TriangleMesh readMeshPly(const fs::path& path);
 

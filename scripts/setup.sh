@@ -20,6 +20,7 @@ packages=(
   libembree-dev libosmesa6-dev libstb-dev libtinyobjloader-dev
   libgtest-dev libbenchmark-dev ffmpeg gnuplot-nox zlib1g-dev libbullet-dev
   slurm-wlm munge clang libclang-rt-14-dev
+  python3-vtk9 python3-numpy chromium
 )
 
 missing=()

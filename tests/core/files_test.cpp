@@ -63,6 +63,22 @@ TEST(Files, FrameRanges) {
   EXPECT_THROW(FrameRange::parse("a:b"), InputError);
 }
 
+// The report and the USD export read stats.csv and bodies.csv by column name; a row a killed run cut short is left out.
+TEST(Files, CsvTablesByColumnName) {
+  const fs::path dir = fs::path(testing::TempDir()) / "surge_csv_test";
+  fs::create_directories(dir);
+  writeFileAtomically(dir / "bodies.csv",
+                      [](std::ostream& out) { out << "frame,body,x\n0,crate,0.5\n1,crate,0.25\n2,cra"; });
+  const CsvTable table = readCsvTable(dir / "bodies.csv");
+  ASSERT_EQ(table.rows.size(), 2u);
+  EXPECT_EQ(table.column("x"), 2);
+  EXPECT_EQ(table.column("y"), -1);
+  EXPECT_EQ(table.rows[1][2], "0.25");
+  writeFileAtomically(dir / "empty.csv", [](std::ostream&) {});
+  EXPECT_THROW(readCsvTable(dir / "empty.csv"), InputError);
+  EXPECT_EQ(escapeXml("a<b & \"c\">"), "a&lt;b &amp; &quot;c&quot;&gt;");
+}
+
 TEST(Parallel, SumIsTheSameWhateverTheThreadCount) {
   // Floating-point sums depend on their order; fixed chunks make the order independent of the threads.
   auto sum = [] {

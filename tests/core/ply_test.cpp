@@ -57,6 +57,29 @@ TEST(Ply, ParticleFrameRoundTripsBitForBit) {
     EXPECT_EQ(entry.path().filename().string().rfind("particles.ply.tmp", 0), std::string::npos) << entry.path();
 }
 
+// The exporters pass on every property of a frame: each column in the file's order, with its type.
+TEST(Ply, VertexColumnsAreEveryPropertyInOrder) {
+  ParticleFrame frame;
+  frame.resize(2);
+  frame.fluid = {0, 3};
+  frame.position = {Eigen::Vector3f(0.25f, 1e-7f, -3), Eigen::Vector3f(1, 2, 3)};
+  frame.velocity = {Eigen::Vector3f(0.5f, 0, 0), Eigen::Vector3f(0, -9.81f, 0)};
+  frame.id = {7, 4000000000u};
+  const fs::path path = tempPath("columns.ply");
+  writeParticlePly(path, frame);
+  const std::vector<PlyColumn> columns = readVertexColumns(path);
+  ASSERT_EQ(columns.size(), 8u);
+  const char* names[8] = {"x", "y", "z", "vx", "vy", "vz", "id", "fluid"};
+  for (size_t c = 0; c < 8; ++c) EXPECT_EQ(columns[c].name, names[c]);
+  EXPECT_EQ(columns[0].type, "float");
+  EXPECT_EQ(columns[6].type, "uint");
+  EXPECT_EQ(columns[7].type, "uchar");
+  EXPECT_EQ(float(columns[1].values[0]), 1e-7f);
+  EXPECT_EQ(float(columns[4].values[1]), -9.81f);
+  EXPECT_EQ(columns[6].values[1], 4000000000.0);
+  EXPECT_EQ(columns[7].values[1], 3.0);
+}
+
 TEST(Ply, MeshRoundTrips) {
   TriangleMesh mesh;
   mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
