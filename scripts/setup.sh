@@ -20,7 +20,7 @@ packages=(
   libembree-dev libosmesa6-dev libstb-dev libtinyobjloader-dev
   libgtest-dev libbenchmark-dev ffmpeg gnuplot-nox zlib1g-dev libbullet-dev
   slurm-wlm munge clang libclang-rt-14-dev
-  python3-vtk9 python3-numpy chromium
+  python3-vtk9 python3-numpy chromium pybind11-dev python3-dev python3-pytest
 )
 
 missing=()

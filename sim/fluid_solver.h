@@ -55,6 +55,7 @@ class FluidSolver {
   // The particles in the solver's current order (it reorders them by grid cell), and their mass.
   virtual const std::vector<Vec<Dim>>& positions() const = 0;
   virtual const std::vector<Vec<Dim>>& velocities() const = 0;
+  virtual const std::vector<uint32_t>& ids() const = 0;
   virtual float particleMass() const = 0;
   // Each particle's mass over particleMass() in a scene of several fluids (empty in a scene of one).
   virtual const std::vector<float>& massRatios() const = 0;

@@ -101,6 +101,7 @@ class ParticleSolver : public FluidSolver<Dim> {
   size_t size() const final { return x_.size(); }
   const std::vector<VecD>& positions() const final { return x_; }
   const std::vector<VecD>& velocities() const final { return v_; }
+  const std::vector<uint32_t>& ids() const final { return id_; }
   float particleMass() const final { return mass_; }
   const std::vector<float>& massRatios() const final { return massRatio_; }
   uint32_t particleId(size_t i) const { return id_[i]; }

@@ -129,92 +129,89 @@ uint32_t startParticles(const Scene& scene, const fs::path& dir, bool resume, Fl
 // left end exactly on the frame: dt = remaining / ceil(remaining / stable). A solver with fixedSubsteps() > 0
 // takes that many equal steps a frame while the stable step is no shorter, which is then its longest (a frame
 // whose steps all meet the need runs as before the need was checked). Each frame's record goes to every
-// FrameOutput.
+// FrameOutput. The constructor sets the run up and writes frame 0 (when it starts afresh); stepFrame() runs one
+// frame and writes it.
 template <int Dim>
-SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
-                      bool resume, Progress& progress) {
-  const auto runStart = std::chrono::steady_clock::now();
-  removeStaleFiles(dir / "particles", !resume);
-  removeStaleFiles(dir / "solver", !resume);
-  fs::create_directories(dir / "particles");
+class FrameLoop final : public SimulationRun {
+ public:
+  FrameLoop(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir, bool resume)
+      : scene_(scene), frameDuration_(1.0 / scene.output.fps), attractor_(scene.attractor) {
+    // Everything below is made from the run's own copy of the scene, which lives as long as it does.
+    removeStaleFiles(dir / "particles", !resume);
+    removeStaleFiles(dir / "solver", !resume);
+    fs::create_directories(dir / "particles");
 
-  const std::unique_ptr<FluidSolver<Dim>> method = makeFluidSolver<Dim>(scene, shapes);
-  FluidSolver<Dim>& solver = *method;
-  std::unique_ptr<RigidBodies> bodies;
-  if (!scene.bodies.empty()) {
-    bodies = std::make_unique<RigidBodies>(scene, shapes);
-    std::error_code error;
-    if (!resume) fs::remove_all(dir / "bodies", error);
-    fs::create_directories(dir / "bodies");
-  }
-  SimulationSummary summary;
-  const uint32_t firstEmittedId = startParticles<Dim>(scene, dir, resume, solver, bodies.get(), summary);
-  const bool fresh = !resume || listFrames(dir, "particles", "ply").empty();
-  const double frameDuration = 1.0 / scene.output.fps;
-  std::unique_ptr<FluidSources<Dim>> sources;
-  if (scene.hasSources()) {
-    sources = std::make_unique<FluidSources<Dim>>(scene, firstEmittedId, summary.firstFrame * frameDuration);
-    if (fresh) sources->checkStart(solver.positions(), solver.colliders());
-  }
-  const std::vector<std::unique_ptr<FrameOutput>> outputs =
-      makeFrameOutputs(scene, shapes, bodies.get(), dir, resume, !fresh, summary.firstFrame);
-  ParticleFrame frame;
-  FrameRecord record;
-  record.particles = &frame;
-  const FluidMethod& registered = fluidMethod(scene.solver.method, scene.source);
-  // The ledger's floor is the fluid moving at a hundredth of the scene's speed, or of a spacing a frame where the
-  // scene gives it none (zero gravity, nothing moving): what rounding stirs in a fluid at rest is no gain.
-  const double speed = sceneSpeed(scene);
-  EnergyLedger ledger(Dim, speed > 0 ? speed : scene.particle_spacing * scene.output.fps,
-                      registered.steadier ? registered.steadier : "shorter steps",
-                      scene.emitters.empty() || registered.emittersAccounted);
-  if (!fresh) ledger.resume(dir / "stats.csv", summary.firstFrame);
-  // What surface tension may release (sim/surface_tension.h); a resumed run counts it again from its first frame.
-  const double surfaceEnergy = sceneSurfaceTension(scene) > 0 ? surfaceEnergyBound(scene, initialParticles(scene)) : 0;
-  double forceWork = 0, forceCredited = 0;
-  const Attractor<Dim> attractor(scene.attractor);
-  auto writeFrame = [&] {
-    record.dam = measureDamBreak(scene, frame);
-    record.potentialEnergy = potentialEnergy(scene, frame, solver.particleMass());
-    record.sourceWork = ledger.sourceWork();
-    if (record.frame == 0) ledger.start(record.measures.kineticEnergy, record.potentialEnergy);
-    else ledger.check(record.frame, record.measures.kineticEnergy, record.potentialEnergy,
-                      solver.particleMass() * double(frame.size()));
-    record.carriedState = solver.carriedState();
-    for (const std::unique_ptr<FrameOutput>& output : outputs) output->write(record);
-  };
-  if (fresh) {
-    // Measured first: before the first step, measuring sorts the particles into cells, and frame 0 must hold
-    // them in the order the run goes on with, or a run resumed from it sums its neighbours in another order.
-    record.measures = solver.measure();
-    solver.getParticles(frame);
-    if (solver.lastDivergenceIterations() >= 0) record.divergenceIterations = 0;
-    writeFrame();
+    method_ = makeFluidSolver<Dim>(scene_, shapes);
+    FluidSolver<Dim>& solver = *method_;
+    if (!scene_.bodies.empty()) {
+      bodies_ = std::make_unique<RigidBodies>(scene_, shapes);
+      std::error_code error;
+      if (!resume) fs::remove_all(dir / "bodies", error);
+      fs::create_directories(dir / "bodies");
+    }
+    const uint32_t firstEmittedId = startParticles<Dim>(scene_, dir, resume, solver, bodies_.get(), summary_);
+    const bool fresh = !resume || listFrames(dir, "particles", "ply").empty();
+    if (scene_.hasSources()) {
+      sources_ = std::make_unique<FluidSources<Dim>>(scene_, firstEmittedId, summary_.firstFrame * frameDuration_);
+      if (fresh) sources_->checkStart(solver.positions(), solver.colliders());
+    }
+    outputs_ = makeFrameOutputs(scene_, shapes, bodies_.get(), dir, resume, !fresh, summary_.firstFrame);
+    record_.particles = &frame_;
+    const FluidMethod& registered = fluidMethod(scene_.solver.method, scene_.source);
+    // The ledger's floor is the fluid moving at a hundredth of the scene_'s speed, or of a spacing a frame where
+    // the scene_ gives it none (zero gravity, nothing moving): what rounding stirs in a fluid at rest is no gain.
+    const double speed = sceneSpeed(scene_);
+    ledger_ = std::make_unique<EnergyLedger>(Dim, speed > 0 ? speed : scene_.particle_spacing * scene_.output.fps,
+                                             registered.steadier ? registered.steadier : "shorter steps",
+                                             scene_.emitters.empty() || registered.emittersAccounted);
+    if (!fresh) ledger_->resume(dir / "stats.csv", summary_.firstFrame);
+    // What surface tension may release (sim/surface_tension.h); a resumed run counts it again from its first frame.
+    surfaceEnergy_ = sceneSurfaceTension(scene_) > 0 ? surfaceEnergyBound(scene_, initialParticles(scene_)) : 0;
+    frameIndex_ = summary_.firstFrame;
+    if (fresh) {
+      // Measured first: before the first step, measuring sorts the particles into cells, and frame 0 must hold
+      // them in the order the run goes on with, or a run resumed from it sums its neighbours in another order.
+      record_.measures = solver.measure();
+      solver.getParticles(frame_);
+      if (solver.lastDivergenceIterations() >= 0) record_.divergenceIterations = 0;
+      writeFrame();
+    }
   }
 
-  constexpr int kMostSteps = 1000000;
-  progress.start("simulate", static_cast<size_t>(scene.output.frames - summary.firstFrame));
-  for (int f = summary.firstFrame + 1; f <= scene.output.frames; ++f) {
-    Progress::checkInterrupt();
+  int frame() const override { return frameIndex_; }
+  double time() const override { return frameIndex_ * frameDuration_; }
+  int dimensions() const override { return Dim; }
+  size_t size() const override { return method_->size(); }
+  const float* positions() const override { return method_->positions().data()->data(); }
+  const float* velocities() const override { return method_->velocities().data()->data(); }
+  const uint32_t* ids() const override { return method_->ids().data(); }
+  const SimulationSummary& summary() const override { return summary_; }
+
+  bool stepFrame() override {
+    if (frameIndex_ >= scene_.output.frames) return false;
+    const int f = ++frameIndex_;
+    FluidSolver<Dim>& solver = *method_;
+    EnergyLedger& ledger = *ledger_;
     const auto frameStart = std::chrono::steady_clock::now();
     solver.phaseTimes() = PhaseTimes{};
-    if (sources) {
-      sources->emitted = sources->removed = 0;
-      sources->work = 0;
+    if (sources_) {
+      sources_->emitted = sources_->removed = 0;
+      sources_->work = 0;
     }
-    double time = (f - 1) * frameDuration;
+    double time = (f - 1) * frameDuration_;
     solver.beginFrame(time);
-    if (bodies) {
-      bodies->beginFrame(time);
-      placeBodies(*bodies, solver.colliders());
+    if (bodies_) {
+      bodies_->beginFrame(time);
+      placeBodies(*bodies_, solver.colliders());
     }
     int iterations = 0, divergenceIterations = 0, steps = 0;
     float smallestStep = INFINITY;
-    double remaining = frameDuration;
+    double remaining = frameDuration_;
     bool shortened = false;  // a step of this frame was shorter than the fixed substeps'
+    constexpr int kMostSteps = 1000000;
     while (remaining > 0) {
       float dt;
-      const float fixed = solver.fixedSubsteps() > 0 ? static_cast<float>(frameDuration / solver.fixedSubsteps()) : 0;
+      const float fixed = solver.fixedSubsteps() > 0 ? static_cast<float>(frameDuration_ / solver.fixedSubsteps()) : 0;
       const double stable = solver.stableTimeStep();
       if (fixed > 0 && !shortened && stable >= fixed) {
         dt = fixed;
@@ -227,63 +224,85 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
         remaining = count == 1 ? 0 : remaining - dt;
       }
       long badBody = -1;
-      if (attractor.active()) ledger.add(attractorWork(attractor, solver, time, dt));
-      const long bad = coupledStep<Dim>(solver, bodies.get(), dt, time, badBody);
+      if (attractor_.active()) ledger.add(attractorWork(attractor_, solver, time, dt));
+      const long bad = coupledStep<Dim>(solver, bodies_.get(), dt, time, badBody);
       time += dt;
       if (badBody >= 0)
         throw RunError("simulation diverged at frame " + std::to_string(f) + ", substep " + std::to_string(steps) +
-                       ": body " + scene.bodies[badBody].solid.name + " (its state is not finite)");
+                       ": body " + scene_.bodies[badBody].solid.name + " (its state is not finite)");
       smallestStep = std::min(smallestStep, dt);
       iterations += solver.lastIterations();
       divergenceIterations += solver.lastDivergenceIterations();
       if (bad >= 0) {
-        solver.getParticles(frame);
-        diverged(scene, f, steps, bad, frame);
+        solver.getParticles(frame_);
+        diverged(scene_, f, steps, bad, frame_);
       }
-      if (sources) sources->apply(solver, time);
+      if (sources_) sources_->apply(solver, time);
       if (++steps >= kMostSteps)
         throw RunError("simulation stalled at frame " + std::to_string(f) + ": a million steps of " +
                        std::to_string(dt) + " s did not finish the frame (the stable step collapsed)");
     }
-    record = FrameRecord{};
-    record.particles = &frame;
-    record.frame = f;
-    record.time = f * frameDuration;
-    record.measures = solver.measure();
-    solver.getParticles(frame);
-    record.steps = steps;
-    record.iterations = double(iterations) / steps;
-    record.divergenceIterations = divergenceIterations < 0 ? NAN : double(divergenceIterations) / steps;
-    record.smallestStep = smallestStep;
-    record.pressureMax = solver.maxPressure();
-    if (sources) {
-      record.emitted = sources->emitted;
-      record.removed = sources->removed;
-      ledger.add(sources->work);
+    record_ = FrameRecord{};
+    record_.particles = &frame_;
+    record_.frame = f;
+    record_.time = f * frameDuration_;
+    record_.measures = solver.measure();
+    solver.getParticles(frame_);
+    record_.steps = steps;
+    record_.iterations = double(iterations) / steps;
+    record_.divergenceIterations = divergenceIterations < 0 ? NAN : double(divergenceIterations) / steps;
+    record_.smallestStep = smallestStep;
+    record_.pressureMax = solver.maxPressure();
+    if (sources_) {
+      record_.emitted = sources_->emitted;
+      record_.removed = sources_->removed;
+      ledger.add(sources_->work);
     }
     // Surface tension's work is surface energy released: credited up to the most the fluid's surface held.
-    forceWork += solver.takeForceWork();
-    const double credit = std::min(forceWork, surfaceEnergy) - forceCredited;
+    forceWork_ += solver.takeForceWork();
+    const double credit = std::min(forceWork_, surfaceEnergy_) - forceCredited_;
     ledger.add(credit);
-    forceCredited += credit;
-    record.phases = solver.phaseTimes();
-    record.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart).count();
-    if (!scene.colliders.empty() || bodies) {
-      std::vector<Wrench> wrenches = solver.takeColliderWrenches(frameDuration);
-      const auto firstBody = wrenches.begin() + std::ptrdiff_t(scene.colliders.size());
-      record.bodyWrenches.assign(firstBody, wrenches.end());
-      record.colliderWrenches.assign(wrenches.begin(), firstBody);
+    forceCredited_ += credit;
+    record_.phases = solver.phaseTimes();
+    record_.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - frameStart).count();
+    if (!scene_.colliders.empty() || bodies_) {
+      std::vector<Wrench> wrenches = solver.takeColliderWrenches(frameDuration_);
+      const auto firstBody = wrenches.begin() + std::ptrdiff_t(scene_.colliders.size());
+      record_.bodyWrenches.assign(firstBody, wrenches.end());
+      record_.colliderWrenches.assign(wrenches.begin(), firstBody);
       for (const Wrench& w : wrenches) ledger.add(w.work);
     }
     writeFrame();
-    progress.advance();
+    return true;
   }
-  progress.finish();
-  summary.lastFrame = scene.output.frames;
-  summary.particles = solver.size();
-  summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - runStart).count();
-  return summary;
-}
+
+ private:
+  void writeFrame() {
+    FluidSolver<Dim>& solver = *method_;
+    record_.dam = measureDamBreak(scene_, frame_);
+    record_.potentialEnergy = potentialEnergy(scene_, frame_, solver.particleMass());
+    record_.sourceWork = ledger_->sourceWork();
+    if (record_.frame == 0) ledger_->start(record_.measures.kineticEnergy, record_.potentialEnergy);
+    else ledger_->check(record_.frame, record_.measures.kineticEnergy, record_.potentialEnergy,
+                        solver.particleMass() * double(frame_.size()));
+    record_.carriedState = solver.carriedState();
+    for (const std::unique_ptr<FrameOutput>& output : outputs_) output->write(record_);
+  }
+
+  const Scene scene_;
+  const double frameDuration_;
+  const Attractor<Dim> attractor_;
+  std::unique_ptr<FluidSolver<Dim>> method_;
+  std::unique_ptr<RigidBodies> bodies_;
+  std::unique_ptr<FluidSources<Dim>> sources_;
+  std::vector<std::unique_ptr<FrameOutput>> outputs_;
+  std::unique_ptr<EnergyLedger> ledger_;
+  SimulationSummary summary_;
+  ParticleFrame frame_;
+  FrameRecord record_;
+  double surfaceEnergy_ = 0, forceWork_ = 0, forceCredited_ = 0;
+  int frameIndex_ = 0;
+};
 
 // A fluid given as a shape: the sites of the tank's lattice (domain.min + spacing (i + 1/2)) inside it.
 void addShapedFluid(const Scene& scene, size_t index, ParticleFrame& frame) {
@@ -417,10 +436,29 @@ SimulationSummary simulate(const Scene& scene, const fs::path& dir, bool resume,
   return simulate(scene, buildColliderShapes(scene), dir, resume, progress);
 }
 
+std::unique_ptr<SimulationRun> SimulationRun::start(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes,
+                                                   const fs::path& dir, bool resume) {
+  if (!shapes) shapes = buildColliderShapes(scene);
+  if (scene.dimensions == 2) return std::make_unique<FrameLoop<2>>(scene, std::move(shapes), dir, resume);
+  return std::make_unique<FrameLoop<3>>(scene, std::move(shapes), dir, resume);
+}
+
 SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
                            bool resume, Progress& progress) {
-  return scene.dimensions == 2 ? run<2>(scene, shapes, dir, resume, progress)
-                               : run<3>(scene, shapes, dir, resume, progress);
+  const auto runStart = std::chrono::steady_clock::now();
+  const std::unique_ptr<SimulationRun> run = SimulationRun::start(scene, std::move(shapes), dir, resume);
+  progress.start("simulate", static_cast<size_t>(scene.output.frames - run->frame()));
+  while (run->frame() < scene.output.frames) {
+    Progress::checkInterrupt();
+    run->stepFrame();
+    progress.advance();
+  }
+  progress.finish();
+  SimulationSummary summary = run->summary();
+  summary.lastFrame = scene.output.frames;
+  summary.particles = run->size();
+  summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - runStart).count();
+  return summary;
 }
 
 }  // namespace surge

@@ -2,6 +2,8 @@
 // frame, particle frames and stats.csv written atomically, divergence stops, resume from the last frame.
 #pragma once
 
+#include <memory>
+
 #include "core/ply.h"
 #include "core/progress.h"
 #include "core/scene.h"
@@ -38,6 +40,27 @@ struct SimulationSummary {
 // With bodies (sim/rigid_bodies.h): bodies.csv (frames 0..N), bodies/<name>.ply and bodies/<name>/frame_NNNNN.ply
 // (each body's mesh in the world), and bodies/frame_NNNNN.txt, the state a resumed run continues from.
 SimulationSummary simulate(const Scene& scene, const fs::path& dir, bool resume, Progress& progress);
+
+// The same run a frame at a time, for a caller that looks at the particles between frames (the Python module):
+// start() sets it up as simulate() does and writes frame 0 (or picks up the newest frame with resume);
+// stepFrame() simulates and writes the next frame, false once the last frame is written. The particles are in
+// the solver's order (it sorts them by cell), x, y(, z) a particle, Dim floats each; valid until the next step.
+class SimulationRun {
+ public:
+  static std::unique_ptr<SimulationRun> start(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes,
+                                              const fs::path& dir, bool resume);
+  virtual ~SimulationRun() = default;
+  virtual bool stepFrame() = 0;
+  virtual int frame() const = 0;      // the newest frame written
+  virtual double time() const = 0;    // its time, frame / output.fps
+  virtual int dimensions() const = 0;
+  virtual size_t size() const = 0;
+  virtual const float* positions() const = 0;
+  virtual const float* velocities() const = 0;
+  virtual const uint32_t* ids() const = 0;
+  virtual const SimulationSummary& summary() const = 0;
+};
+
 SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,
                            bool resume, Progress& progress);
 

@@ -1,0 +1,80 @@
+"""The `surge` Python module (issue 36): a run from Python writes the same bytes as `surge sim`, its arrays are
+views of the solver's memory that agree with the frames, read_frame gives each property its own type, and the
+surface and render stages run on a folder. Run by ctest with PYTHONPATH at build/python (tests/CMakeLists.txt)."""
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import surge
+
+SOURCE = os.environ["SURGE_SOURCE_DIR"]
+BINARY = os.environ["SURGE_BINARY"]
+SCENE = os.path.join(SOURCE, "scenes", "dam_break_2d.json")
+
+
+def frames(folder):
+    return sorted(os.listdir(os.path.join(folder, "particles")))
+
+
+@pytest.mark.parametrize("method", ["pbf", "dfsph"])
+def test_a_run_from_python_writes_the_same_bytes_as_surge_sim(tmp_path, method):
+    sets = ["output.frames=4", f"solver.method={method}"]
+    cli = tmp_path / "cli"
+    subprocess.run([BINARY, "sim", SCENE, "--quiet", "--out", str(cli)] + sum((["--set", s] for s in sets), []),
+                   check=True)
+    sim = surge.Simulation(SCENE, sets, out=str(tmp_path / "py"))
+    assert sim.frame == 0 and sim.time == 0.0
+    steps = 0
+    while sim.step_frame():
+        steps += 1
+    assert steps == 4 and sim.frame == 4
+    assert sim.time == pytest.approx(4 / 30)
+    assert sim.step_frame() is False
+    assert frames(cli) == frames(tmp_path / "py")
+    for name in frames(cli):
+        assert (cli / "particles" / name).read_bytes() == (tmp_path / "py" / "particles" / name).read_bytes(), name
+    for name in os.listdir(cli / "solver") if (cli / "solver").exists() else []:
+        assert (cli / "solver" / name).read_bytes() == (tmp_path / "py" / "solver" / name).read_bytes(), name
+
+
+def test_the_arrays_are_views_of_the_solver_and_match_the_frame(tmp_path):
+    sim = surge.Simulation(SCENE, ["output.frames=2"], out=str(tmp_path))
+    sim.step_frame()
+    x, v, ids = sim.positions(), sim.velocities(), sim.ids()
+    assert x.shape == (len(ids), 2) and v.shape == x.shape
+    assert x.dtype == np.float32 and ids.dtype == np.uint32
+    assert not x.flags["OWNDATA"] and not ids.flags["OWNDATA"]
+    assert np.shares_memory(x, sim.positions())  # no copy: the same memory each time
+    frame = surge.read_frame(str(tmp_path / "particles" / "frame_00001.ply"))
+    assert frame["x"].dtype == np.float32 and frame["id"].dtype == np.uint32
+    assert set(["x", "y", "z", "vx", "vy", "vz", "id"]) <= set(frame)
+    np.testing.assert_array_equal(frame["x"], x[:, 0])
+    np.testing.assert_array_equal(frame["y"], x[:, 1])
+    np.testing.assert_array_equal(frame["vy"], v[:, 1])
+    np.testing.assert_array_equal(frame["id"], ids)
+    assert np.all(frame["z"] == 0)
+    # The water has started to fall and run: it moves, and no particle is lost or doubled.
+    assert np.abs(v).max() > 0.1
+    assert len(np.unique(ids)) == len(ids)
+
+
+def test_surface_and_render_run_on_a_folder(tmp_path):
+    sim = surge.Simulation(SCENE, ["output.frames=1"], out=str(tmp_path))
+    sim.step_frame()
+    surge.surface(str(tmp_path), frames="1:1")
+    assert (tmp_path / "surface" / "frame_00001.ply").stat().st_size > 1000
+    assert (tmp_path / "surface" / "frame_00001.vdb").stat().st_size > 1000
+    surge.render(str(tmp_path), frames="1:1", renderer="gl")
+    png = (tmp_path / "frames" / "frame_00001.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_bad_input_names_the_file_or_key(tmp_path):
+    with pytest.raises(ValueError, match="missing.json"):
+        surge.Simulation(str(tmp_path / "missing.json"))
+    with pytest.raises(ValueError, match="solver.iterations"):
+        surge.Simulation(SCENE, ["solver.iterations=-3"], out=str(tmp_path / "bad"))
+    with pytest.raises(ValueError, match="scene.json"):
+        surge.surface(str(tmp_path / "nothing_here"))
