@@ -182,7 +182,7 @@ TEST(EndToEnd, BadSceneIsOneLineExitTwoAndWritesNothing) {
 }
 
 TEST(EndToEnd, HelpForEveryCommand) {
-  for (const char* command : {"", "run", "sim", "surface", "render", "video", "keys"}) {
+  for (const char* command : {"", "run", "sim", "surface", "render", "video", "keys", "export", "report"}) {
     const SurgeResult r = runSurge(std::string(command) + " --help");
     EXPECT_EQ(r.status, 0) << command;
     EXPECT_NE(r.out.find("--help"), std::string::npos) << command;
