@@ -185,16 +185,16 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
         const VecD vij = v_[i] - v_[*j];
         const float mu = vij.dot(r) / (length * length + eta2);
         // With several fluids m_j / m_i times a pair's mean mass over m_0 (2 m_j / (m_i + m_j)), so that
-        // m_i a_ij = -m_j a_ji.
-        const float pairMass = several ? 2.0f * massRatio[*j] / (massRatio[i] + massRatio[*j]) : 1.0f;
+        // m_i a_ij = -m_j a_ji; computed only for a pair that has such a force.
+        const auto pairMass = [&] { return several ? 2.0f * massRatio[*j] / (massRatio[i] + massRatio[*j]) : 1.0f; };
         if (alpha_ > 0 && mu < 0) {
           const float meanDensity = 0.5f * (density_[i] + density_[*j]);
-          viscousForce += (pairMass * alpha_ * speedOfSound_ * h * mu / meanDensity) * gradient;
+          viscousForce += (pairMass() * alpha_ * speedOfSound_ * h * mu / meanDensity) * gradient;
         }
-        if (nu_ > 0) viscousForce += (pairMass * laminar * mu / density_[*j]) * gradient;
+        if (nu_ > 0) viscousForce += (pairMass() * laminar * mu / density_[*j]) * gradient;
         if (near && length > 1e-12f) {
           const float d = std::max(1.0f - length * inverseSupport, 0.0f);
-          nearForce += (pairMass * (nearPressure_[i] + nearPressure_[*j]) * d * d * inverseSupport / length) * r;
+          nearForce += (pairMass() * (nearPressure_[i] + nearPressure_[*j]) * d * d * inverseSupport / length) * r;
         }
       }
       // The walls as mirrored particles with this particle's pressure continued hydrostatically, as the
