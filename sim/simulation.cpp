@@ -189,6 +189,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     record.measures = solver.measure();
     solver.getParticles(frame);
     if (solver.lastDivergenceIterations() >= 0) record.divergenceIterations = 0;
+    if (solver.lastViscosityIterations() >= 0) record.viscosityIterations = 0;
     writeFrame();
   }
 
@@ -208,7 +209,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
       bodies->beginFrame(time);
       placeBodies(*bodies, solver.colliders());
     }
-    int iterations = 0, divergenceIterations = 0, steps = 0;
+    int iterations = 0, divergenceIterations = 0, viscosityIterations = 0, steps = 0;
     float smallestStep = INFINITY;
     double remaining = frameDuration;
     bool shortened = false;  // a step of this frame was shorter than the fixed substeps'
@@ -236,6 +237,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
       smallestStep = std::min(smallestStep, dt);
       iterations += solver.lastIterations();
       divergenceIterations += solver.lastDivergenceIterations();
+      viscosityIterations += solver.lastViscosityIterations();
       if (bad >= 0) {
         solver.getParticles(frame);
         diverged(scene, f, steps, bad, frame);
@@ -254,6 +256,7 @@ SimulationSummary run(const Scene& scene, std::shared_ptr<const ColliderShapes> 
     record.steps = steps;
     record.iterations = double(iterations) / steps;
     record.divergenceIterations = divergenceIterations < 0 ? NAN : double(divergenceIterations) / steps;
+    record.viscosityIterations = viscosityIterations < 0 ? NAN : double(viscosityIterations) / steps;
     record.smallestStep = smallestStep;
     record.pressureMax = solver.maxPressure();
     if (sources) {
