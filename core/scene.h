@@ -56,6 +56,11 @@ struct SolverSettings {
   double kinematic_viscosity = 0;        // laminar nu (m^2/s); 0 turns it off
   double near_pressure = 0;              // Clavet et al. 2005 near-pressure stiffness; 0 turns it off
   std::string surface_tension_model = "akinci2013";  // how fluids[i].surface_tension acts (sim/surface_tension.h)
+  // How fluids[i].viscosity acts (sim/viscosity.h): "implicit", "explicit", or "default": explicit for WCSPH,
+  // implicit for the others.
+  std::string viscosity_solver = "default";
+  double viscosity_max_error = 0.01;  // the implicit solve's relative residual |r| / |b|
+  int viscosity_max_iterations = 100;
 };
 
 struct AttractorKeyframe {
@@ -102,6 +107,7 @@ struct ColliderSettings {
   std::vector<ColliderKeyframe> motion;
   double friction = 0;
   double adhesion = 0;         // W_adhesion / (2 sigma) of the fluid on it (sim/surface_tension.h); 0 none
+  double viscous_slip = 0;     // a viscous fluid along it: 0 no slip, 1 free slip (sim/viscosity.h)
   Eigen::Vector3d color = Eigen::Vector3d(0.62, 0.6, 0.56);
   int visible = 1;
 };
@@ -126,6 +132,7 @@ struct FluidBlock {
   ColliderSettings solid = shapeless();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   double surface_tension = 0;  // sigma, N/m (N in 2D); 0 none
+  double viscosity = 0;        // kinematic nu, m^2/s (sim/viscosity.h); 0 none
   // The fluid it is (blocks of one name are one fluid). Empty in the file: "water" (resolved).
   std::string name;
   double rest_density = 0;  // kg/m^3 (kg/m^2 in 2D); 0 in the file: solver.rest_density (resolved)
@@ -243,6 +250,7 @@ struct Scene {
   int dimensions = 3;
   Box domain;
   std::vector<std::string> open;  // domain.open: tank faces that are not walls (tankFaceNames)
+  double viscous_slip = 0;        // domain.viscous_slip: a viscous fluid along the tank's walls, 0 no slip
   double particle_spacing = 0;
   std::vector<FluidBlock> fluids;
   Eigen::Vector3d gravity = Eigen::Vector3d(0, -9.81, 0);

@@ -92,6 +92,9 @@ void visitSolid(SceneVisitor& v, ColliderSettings& c, bool body) {
          atLeast(0, "Akinci 2013's adhesion of the fluid to it, as the work of adhesion over the fluid's work of "
                     "cohesion (Young: cos theta = 2 adhesion - 1; 0.5 wets at 90 degrees, 1 spreads); acts with "
                     "the fluid's surface_tension; 0 turns it off", "", 1));
+  v.real("viscous_slip", c.viscous_slip,
+         atLeast(0, "a viscous fluid (fluids[i].viscosity) along it: 0 sticks to it (no slip), 1 slides freely",
+                 "", 1));
   v.vector("color", c.color, atLeast(0, "linear RGB albedo in the renders", "", 1), true);
   v.integer("visible", c.visible, atLeast(0, "0: simulated but not drawn", "", 1));
 }
@@ -178,6 +181,9 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.choices("open", s.open, tankFaceNames(),
               info("faces that are not walls (2D: -x, +x, -y, +y): a particle crossing one is removed, and the "
                    "renders leave it out"));
+    v.real("viscous_slip", s.viscous_slip,
+           atLeast(0, "a viscous fluid (fluids[i].viscosity) along the walls: 0 sticks to them (no slip), 1 "
+                      "slides freely", "", 1));
   });
   v.real("particle_spacing", s.particle_spacing,
          positive("initial lattice spacing; the particle radius is half of it", "m", true));
@@ -197,6 +203,10 @@ void visitScene(Scene& s, SceneVisitor& v) {
                info("the fluid it is: blocks of one name are one fluid, and a scene of several fluids writes "
                     "each particle's in its frames (`fluid`, the index of the fluid's first block) and a surface "
                     "for each (surface_<name> after the first); empty: water"));
+        v.real("viscosity", f.viscosity,
+               atLeast(0, "that fluid's kinematic viscosity nu (water 1e-6, honey 0.01 to 0.1), by "
+                          "solver.viscosity_solver, no-slip at the walls; 0 none (WCSPH: solver.kinematic_viscosity, its own "
+                          "pair term, where no fluid gives one)", "m^2/s"));
         v.real("rest_density", f.rest_density,
                positive("that fluid's rest density (oil about 900, water 1000); not given: solver.rest_density",
                         "kg/m^3"));
@@ -271,6 +281,15 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.choice("surface_tension_model", s.solver.surface_tension_model, {"akinci2013"},
              info("how fluids[i].surface_tension acts: akinci2013, cohesion and curvature forces (Akinci, Akinci "
                   "and Teschner 2013) calibrated so that sigma is N/m (docs/surface-tension.md)"));
+    v.choice("viscosity_solver", s.solver.viscosity_solver, {"default", "implicit", "explicit"},
+             info("how fluids[i].viscosity acts: implicit, Weiler et al. 2018's backward Euler solved by "
+                  "conjugate gradients (no step limit); explicit, Morris et al. 1997 (dt <= 0.125 (h/2)^2 / nu); "
+                  "default: explicit for WCSPH, implicit for the others (docs/viscosity.md)"));
+    v.real("viscosity_max_error", s.solver.viscosity_max_error,
+           positive("the implicit viscosity solve stops when its residual over its right side, |r| / |b|, is "
+                    "under it"));
+    v.integer("viscosity_max_iterations", s.solver.viscosity_max_iterations,
+              atLeast(1, "the most conjugate-gradient iterations of the implicit viscosity solve a step", "", 10000));
     FieldInfo cfl = positive("Courant number. WCSPH: dt <= cfl h / (c + |v|max), h = kernel_radius / 2; DFSPH: "
                              "dt <= cfl particle_spacing / |v|max; PBF: dt <= cfl kernel_radius / |v|max");
     cfl.max = 1;

@@ -116,6 +116,11 @@ void validateFluids(Scene& s, const std::string& where) {
       throw InputError(where, key + ".color",
                        "differs from fluids[" + std::to_string(s.fluidOf(i)) + "]'s, a block of the same fluid '" +
                            fluid.name + "': give it another name");
+    if (fluid.viscosity != first.viscosity)
+      throw InputError(where, key + ".viscosity",
+                       formatNumber(fluid.viscosity) + " differs from fluids[" + std::to_string(s.fluidOf(i)) +
+                           "]'s " + formatNumber(first.viscosity) + ", a block of the same fluid '" + fluid.name +
+                           "': give it another name");
     if (fluid.name != s.fluids[0].name && i == s.fluidOf(i)) {  // the scene's second fluid, or a later one
       if (fluid.surface_tension > 0 || s.fluids[0].surface_tension > 0)
         throw InputError(where, key + ".surface_tension", "surface tension with several fluids is not built yet");

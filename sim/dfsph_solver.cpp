@@ -56,7 +56,7 @@ template <int Dim>
 float DfsphSolver<Dim>::stableTimeStep() {
   const float fastest = this->fastestAfterFall(maxStep_);
   const float step = fastest > 0 ? std::min(maxStep_, cfl_ * spacing_ / fastest) : maxStep_;
-  return std::min(step, this->tension_.stableStep());
+  return std::min({step, this->tension_.stableStep(), this->viscosity_.stableStep()});
 }
 
 template <int Dim>
@@ -170,6 +170,7 @@ void DfsphSolver<Dim>::applyNonPressureForces(float dt, double time) {
     for (size_t i = b; i < e; ++i) external.kick(x_[i], v_[i]);
   });
   this->kickSurfaceTension(x_, dt);
+  this->applyViscosity(x_, dt);
   if (xsphC_ > 0) {
     std::vector<VecD>& smoothed = vectorScratch_;
     smoothed.resize(size());

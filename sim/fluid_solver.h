@@ -87,6 +87,8 @@ class FluidSolver {
   virtual FluidMeasures measure() = 0;
   virtual int lastIterations() const = 0;
   virtual int lastDivergenceIterations() const { return -1; }
+  // The implicit viscosity solve's iterations in the last step (0 explicit), or -1 without viscosity.
+  virtual int lastViscosityIterations() const { return -1; }
   virtual float maxPressure() const { return NAN; }
   virtual PhaseTimes& phaseTimes() = 0;
   // The work the method's cohesive forces (surface tension, adhesion) did on the fluid since the last call (J):

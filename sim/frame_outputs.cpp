@@ -90,6 +90,7 @@ const StatsColumn kStatsColumns[] = {
     {"removed", [](const FrameRecord& r) { return std::to_string(r.removed); }},
     {"potential_energy", [](const FrameRecord& r) { return printed("%.6g", r.potentialEnergy); }},
     {"source_work", [](const FrameRecord& r) { return printed("%.9g", r.sourceWork); }},
+    {"viscosity_iterations", [](const FrameRecord& r) { return printed("%.2f", r.viscosityIterations); }},
 };
 
 class StatsOutput final : public FrameOutput {

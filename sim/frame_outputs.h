@@ -33,6 +33,7 @@ struct FrameRecord {
   int steps = 0;                 // 0 for frame 0
   double iterations = 0;         // a step, on average
   double divergenceIterations = NAN;  // a step, on average; NaN for a method without a divergence solver
+  double viscosityIterations = NAN;   // the implicit viscosity solve's, a step on average; NaN without viscosity
   double smallestStep = 0, wallSeconds = 0;
   double pressureMax = NAN;      // NaN for a method without pressures
   double potentialEnergy = 0;    // the fluid's, against the tank's floor (potentialEnergy, sim/simulation.h)

@@ -23,6 +23,7 @@ ParticleSolver<Dim>::ParticleSolver(const Scene& scene, std::shared_ptr<const Co
       gravity_(toVec<Dim>(scene.gravity)),
       attractor_(scene.attractor),
       tension_(scene, mass_),
+      viscosity_(scene, static_cast<float>(scene.solver.kernel_radius)),
       grid_(lattice.walls.domainMin(), lattice.walls.domainMax(),
             NeighborGrid<Dim>::cellSizeFor(static_cast<float>(scene.solver.kernel_radius))),
       walls_(std::move(lattice.walls)),
@@ -65,6 +66,7 @@ void ParticleSolver<Dim>::setParticles(const ParticleFrame& frame) {
   colliders_.resetSlots(n);
   speedLimit_ = runawaySpeedFor(sceneSpeedLimit_, v_);
   resizeChannels(n);
+  viscosity_.resize(n);
 }
 
 template <int Dim>
@@ -116,7 +118,7 @@ void ParticleSolver<Dim>::editParticles(const ParticleEdit<Dim>& edit) {
   if (!fluidMassRatio_.empty()) setFluids(std::vector<uint8_t>(fluid_), n);  // an emitter's are fluid 0
   // The carried channels step aside while the method sizes its others, then come back, new particles at 0.
   size_t channels = 0;
-  forEachCarriedChannel([&](std::vector<float>& channel) {
+  forEachCarried([&](std::vector<float>& channel) {
     if (!edit.remove.empty()) compact(channel);
     channel.resize(n, 0.0f);
     if (carriedHold_.size() <= channels) carriedHold_.emplace_back();
@@ -124,7 +126,7 @@ void ParticleSolver<Dim>::editParticles(const ParticleEdit<Dim>& edit) {
   });
   resizeChannels(n);
   channels = 0;
-  forEachCarriedChannel([&](std::vector<float>& channel) { carriedHold_[channels++].swap(channel); });
+  forEachCarried([&](std::vector<float>& channel) { carriedHold_[channels++].swap(channel); });
   colliders_.resizeSlots(n);
 }
 
@@ -143,7 +145,7 @@ float ParticleSolver<Dim>::fastestAfterFall(float dt) {
 template <int Dim>
 std::vector<float> ParticleSolver<Dim>::carriedState() const {
   std::vector<float> state;
-  const_cast<ParticleSolver*>(this)->forEachCarriedChannel(
+  const_cast<ParticleSolver*>(this)->forEachCarried(
       [&](std::vector<float>& channel) { state.insert(state.end(), channel.begin(), channel.end()); });
   return state;
 }
@@ -151,10 +153,10 @@ std::vector<float> ParticleSolver<Dim>::carriedState() const {
 template <int Dim>
 void ParticleSolver<Dim>::restoreCarriedState(const std::vector<float>& state) {
   size_t channels = 0;
-  forEachCarriedChannel([&](std::vector<float>&) { ++channels; });
+  forEachCarried([&](std::vector<float>&) { ++channels; });
   if (state.size() != channels * size()) throw std::invalid_argument("carried state of the wrong size");
   size_t at = 0;
-  forEachCarriedChannel([&](std::vector<float>& channel) {
+  forEachCarried([&](std::vector<float>& channel) {
     channel.assign(state.begin() + std::ptrdiff_t(at), state.begin() + std::ptrdiff_t(at + size()));
     at += size();
   });
@@ -165,7 +167,7 @@ size_t ParticleSolver<Dim>::coreMemoryBytes() const {
   size_t bytes = (x_.capacity() + v_.capacity() + vectorScratch_.capacity()) * sizeof(VecD);
   bytes += (id_.capacity() + idScratch_.capacity()) * sizeof(uint32_t) + floatScratch_.capacity() * sizeof(float);
   bytes += fluid_.capacity() + byteScratch_.capacity() + (massRatio_.capacity() + inverseMassRatio_.capacity() + fluidMassRatio_.capacity()) * sizeof(float);
-  return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes() + tension_.memoryBytes();
+  return bytes + grid_.memoryBytes() + neighbors_.memoryBytes() + colliders_.memoryBytes() + tension_.memoryBytes() + viscosity_.memoryBytes();
 }
 
 template RestLattice<2> sphRestLattice<2>(const Scene&);

@@ -24,6 +24,7 @@
 #include "sim/neighbor_grid.h"
 #include "sim/surface_tension.h"
 #include "sim/tank.h"
+#include "sim/viscosity.h"
 
 namespace surge {
 
@@ -106,6 +107,7 @@ class ParticleSolver : public FluidSolver<Dim> {
   const std::vector<float>& massRatios() const final { return massRatio_; }
   uint32_t particleId(size_t i) const { return id_[i]; }
   PhaseTimes& phaseTimes() final { return times_; }
+  int lastViscosityIterations() const final { return viscosity_.active() ? viscosity_.lastIterations() : -1; }
   double takeForceWork() final { return tension_.active() ? tension_.takeWork() : 0.0; }
   Colliders<Dim>& colliders() final { return colliders_; }
   const Colliders<Dim>& colliders() const { return colliders_; }
@@ -169,6 +171,14 @@ class ParticleSolver : public FluidSolver<Dim> {
     tension_.kick(v_, dt);
   }
 
+  // The fluid's viscosity (sim/viscosity.h) on v_ at `at` with the current neighbour lists, over a step dt
+  // (counted in the forces phase); nothing without it.
+  void applyViscosity(const std::vector<VecD>& at, float dt) {
+    if (!viscosity_.active()) return;
+    const PhaseTimer timer(times_.forces);
+    viscosity_.apply(at, v_, neighbors_, walls_, colliders_, fluid_, dt);
+  }
+
   // Parameters, fixed at construction. restDensity_ and mass_ are fluid 0's (Scene::referenceDensity).
   const float restDensity_, mass_;
   // Several fluids (Scene::severalFluids): each particle's fluid and its mass over mass_ (rho_f / rho_0, its
@@ -178,6 +188,7 @@ class ParticleSolver : public FluidSolver<Dim> {
   const VecD gravity_;
   const Attractor<Dim> attractor_;
   SurfaceTension<Dim> tension_;  // inactive without surface tension
+  Viscosity<Dim> viscosity_;     // inactive without viscosity
 
   // The particles (structure of arrays), the grid, the walls and the colliders.
   std::vector<VecD> x_, v_;
@@ -199,6 +210,11 @@ class ParticleSolver : public FluidSolver<Dim> {
   std::vector<uint32_t>& scratchFor(std::vector<uint32_t>&) { return idScratch_; }
 
   void setFluids(const std::vector<uint8_t>& fluids, size_t n);
+  // The method's carried channels (forEachCarriedChannel), then the viscosity's warm start.
+  void forEachCarried(const std::function<void(std::vector<float>&)>& visit) {
+    forEachCarriedChannel(visit);
+    viscosity_.forEachCarriedChannel(visit);
+  }
 
   std::vector<std::vector<float>> carriedHold_;  // editParticles: the carried channels while the rest resize
   float sceneSpeedLimit_;  // runawaySpeed(scene)
@@ -223,6 +239,7 @@ void ParticleSolver<Dim>::reorderByCell(std::vector<VecD>& key, Channels&... cha
     if (!channel.empty()) gatherByOrder(order, channel, scratchFor(channel));
   };
   (gather(channels), ...);
+  if (viscosity_.implicit()) viscosity_.forEachCarriedChannel([&](std::vector<float>& channel) { gather(channel); });
 }
 
 extern template class ParticleSolver<2>;

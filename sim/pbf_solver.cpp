@@ -97,7 +97,7 @@ float PbfSolver<Dim>::stableTimeStep() {
   const float g = this->gravity_.norm();
   if (g > 0 && size() > 0)
     dt = std::min(dt, static_cast<float>(depthStableStep(spacing_, g, deepestColumn())));
-  return std::min(dt, this->tension_.stableStep());
+  return std::min({dt, this->tension_.stableStep(), this->viscosity_.stableStep()});
 }
 
 // A column's depth is the volume of its particles over its cell's area: a pool's depth in a pool, a thin jet's
@@ -141,6 +141,7 @@ long PbfSolver<Dim>::step(float dt, double time) {
   solveDensityConstraints();
   updateVelocities(dt);
   this->kickSurfaceTension(p_, dt);
+  this->applyViscosity(p_, dt);
   if (colliders_.hasFriction()) applyFriction();
   if (vorticityEpsilon_ > 0) applyVorticityConfinement(dt);
   if (xsphC_ > 0) applyXsphViscosity();

@@ -158,8 +158,8 @@ class FrameLoop final : public SimulationRun {
     outputs_ = makeFrameOutputs(scene_, shapes, bodies_.get(), dir, resume, !fresh, summary_.firstFrame);
     record_.particles = &frame_;
     const FluidMethod& registered = fluidMethod(scene_.solver.method, scene_.source);
-    // The ledger's floor is the fluid moving at a hundredth of the scene_'s speed, or of a spacing a frame where
-    // the scene_ gives it none (zero gravity, nothing moving): what rounding stirs in a fluid at rest is no gain.
+    // The ledger's floor is the fluid moving at a hundredth of the scene's speed, or of a spacing a frame where
+    // the scene gives it none (zero gravity, nothing moving): what rounding stirs in a fluid at rest is no gain.
     const double speed = sceneSpeed(scene_);
     ledger_ = std::make_unique<EnergyLedger>(Dim, speed > 0 ? speed : scene_.particle_spacing * scene_.output.fps,
                                              registered.steadier ? registered.steadier : "shorter steps",
@@ -174,6 +174,7 @@ class FrameLoop final : public SimulationRun {
       record_.measures = solver.measure();
       solver.getParticles(frame_);
       if (solver.lastDivergenceIterations() >= 0) record_.divergenceIterations = 0;
+      if (solver.lastViscosityIterations() >= 0) record_.viscosityIterations = 0;
       writeFrame();
     }
   }
@@ -204,7 +205,7 @@ class FrameLoop final : public SimulationRun {
       bodies_->beginFrame(time);
       placeBodies(*bodies_, solver.colliders());
     }
-    int iterations = 0, divergenceIterations = 0, steps = 0;
+    int iterations = 0, divergenceIterations = 0, viscosityIterations = 0, steps = 0;
     float smallestStep = INFINITY;
     double remaining = frameDuration_;
     bool shortened = false;  // a step of this frame was shorter than the fixed substeps'
@@ -233,6 +234,7 @@ class FrameLoop final : public SimulationRun {
       smallestStep = std::min(smallestStep, dt);
       iterations += solver.lastIterations();
       divergenceIterations += solver.lastDivergenceIterations();
+      viscosityIterations += solver.lastViscosityIterations();
       if (bad >= 0) {
         solver.getParticles(frame_);
         diverged(scene_, f, steps, bad, frame_);
@@ -251,6 +253,7 @@ class FrameLoop final : public SimulationRun {
     record_.steps = steps;
     record_.iterations = double(iterations) / steps;
     record_.divergenceIterations = divergenceIterations < 0 ? NAN : double(divergenceIterations) / steps;
+    record_.viscosityIterations = viscosityIterations < 0 ? NAN : double(viscosityIterations) / steps;
     record_.smallestStep = smallestStep;
     record_.pressureMax = solver.maxPressure();
     if (sources_) {

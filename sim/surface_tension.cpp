@@ -27,16 +27,6 @@ std::vector<Eigen::Vector3i> latticeOffsets(float spacing, float support) {
   return offsets;
 }
 
-// The particle volume of the rest lattice through the cubic spline: V sum W = 1 at an interior site.
-template <int Dim>
-float latticeVolume(float spacing, const CubicSplineKernel<Dim>& kernel) {
-  double weight = 0, unused = 0;
-  latticeSums<Dim>(
-      spacing, kernel.radius(), [&](const Vec<Dim>& r) { return kernel.value(r.norm()); },
-      [&](const Vec<Dim>& r) -> Vec<Dim> { return kernel.gradientFactor(r.norm()) * r; }, &weight, &unused);
-  return static_cast<float>(1.0 / weight);
-}
-
 // Eq. 2's normalisation, one power of h less in 2D.
 float cohesionNormalisation(int dim, float h) { return static_cast<float>(32.0 / (M_PI * std::pow(double(h), 6 + dim))); }
 

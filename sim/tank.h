@@ -37,6 +37,16 @@ void latticeSums(float spacing, float support, Weight weight, Gradient gradient,
   *gradientSquaredSum = g;
 }
 
+// The particle volume of the rest lattice through the cubic spline: V sum W = 1 at an interior site.
+template <int Dim>
+float latticeVolume(float spacing, const CubicSplineKernel<Dim>& kernel) {
+  double weight = 0, unused = 0;
+  latticeSums<Dim>(
+      spacing, kernel.radius(), [&](const Vec<Dim>& r) { return kernel.value(r.norm()); },
+      [&](const Vec<Dim>& r) -> Vec<Dim> { return kernel.gradientFactor(r.norm()) * r; }, &weight, &unused);
+  return static_cast<float>(1.0 / weight);
+}
+
 // One flat wall's share at distance d from a particle: the kernel weight sum over the lattice beyond it, and the
 // magnitude of the gradient sum, which points from the particle towards the wall. Zero beyond the support; a
 // negative d reads as 0. The tank tabulates it; colliders (sim/colliders.h) use it for every shape, taking the

@@ -22,7 +22,9 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const Collider
   gasConstant_ = static_cast<float>(s.gas_constant);
   taitB_ = restDensity_ * speedOfSound_ * speedOfSound_ / 7.0f;
   alpha_ = static_cast<float>(s.artificial_viscosity);
-  nu_ = static_cast<float>(s.kinematic_viscosity);
+  // solver.kinematic_viscosity, every fluid's when none gives its own: Morris's pair term inside the integrator,
+  // as it always was (no wall term); fluids[i].viscosity goes to the shared solver instead.
+  nu_ = sceneHasViscosity(scene) ? 0.0f : static_cast<float>(s.kinematic_viscosity);
   nearStiffness_ = static_cast<float>(s.near_pressure);
   cfl_ = static_cast<float>(s.cfl);
   fixedStep_ = static_cast<float>(s.time_step);
@@ -74,7 +76,7 @@ float WcsphSolver<Dim>::stableTimeStep() {
   float dt = cfl_ * h / (speedOfSound_ + m.speed);
   if (nu_ > 0) dt = std::min(dt, 0.125f * h * h / nu_);
   if (m.acceleration > 0) dt = std::min(dt, 0.25f * std::sqrt(h / m.acceleration));
-  return std::min(dt, this->tension_.stableStep());
+  return std::min({dt, this->tension_.stableStep(), this->viscosity_.stableStep()});
 }
 
 template <int Dim>
@@ -109,6 +111,8 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
     accelerationsValid_ = false;
   }
+  // The fluids' own viscosity (sim/viscosity.h), explicit or implicit, on the step's end velocities.
+  this->applyViscosity(x_, dt);
   time_ = time + dt;
   return this->firstBadParticle();
 }

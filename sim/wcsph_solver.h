@@ -8,8 +8,11 @@
 //                            colliders' pressure continued from p_i by the hydrostatic gradient (Adami et al.
 //                            2012, eq. 27; TankWalls::hydrostaticSum, Colliders::hydrostaticSum)
 //   viscosity                artificial (Monaghan 1992): Pi_ij = -alpha c h mu_ij / rho_ij for approaching pairs,
-//                            mu_ij = v_ij . x_ij / (|x_ij|^2 + 0.01 h^2); laminar (Morris et al. 1997):
-//                            a_i += 2 (d + 2) nu sum_j (m / rho_j) mu_ij grad W_ij
+//                            mu_ij = v_ij . x_ij / (|x_ij|^2 + 0.01 h^2); laminar (Morris et al. 1997), from
+//                            solver.kinematic_viscosity when no fluid gives its own: a_i += 2 (d + 2) nu
+//                            sum_j (m / rho_j) mu_ij grad W_ij between fluid pairs (no wall term); from
+//                            fluids[i].viscosity: the shared solver at the end of each step (sim/viscosity.h),
+//                            explicit unless solver.viscosity_solver is implicit, no-slip at the walls
 //   near pressure (opt-in)   Clavet et al. 2005's near density sum_j (1 - q)^3 and near pressure k_near times it,
 //                            as a force pushing close pairs apart
 //   gravity and the attractor (sim/attractor.h)

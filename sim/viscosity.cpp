@@ -1,0 +1,254 @@
+#include "sim/viscosity.h"
+
+#include <algorithm>
+
+#include "core/parallel.h"
+
+namespace surge {
+namespace {
+
+// Entries of the wall table across the support, as the tank's flat-wall table.
+constexpr int kWallTableSize = 64;
+
+template <int Dim>
+using Mat = Eigen::Matrix<float, Dim, Dim>;
+
+template <typename VecD>
+double dot(const std::vector<VecD>& a, const std::vector<VecD>& b) {
+  return parallelSum<double>(0, a.size(), [&](size_t begin, size_t end) {
+    double sum = 0;
+    for (size_t i = begin; i < end; ++i) sum += double(a[i].dot(b[i]));
+    return sum;
+  });
+}
+
+}  // namespace
+
+double fluidViscosity(const Scene& scene, size_t block) { return scene.fluids[block].viscosity; }
+
+bool sceneHasViscosity(const Scene& scene) {
+  for (size_t f = 0; f < scene.fluids.size(); ++f)
+    if (fluidViscosity(scene, f) > 0) return true;
+  return false;
+}
+
+bool implicitViscosity(const Scene& scene) {
+  const std::string& chosen = scene.solver.viscosity_solver;
+  return chosen == "default" ? scene.solver.method != "wcsph" : chosen == "implicit";
+}
+
+template <int Dim>
+Viscosity<Dim>::Viscosity(const Scene& scene, float support) {
+  if (!sceneHasViscosity(scene)) return;
+  active_ = true;
+  implicit_ = implicitViscosity(scene);
+  kernel_ = CubicSplineKernel<Dim>(support);
+  const float spacing = static_cast<float>(scene.particle_spacing);
+  const float smoothing = 0.5f * support;
+  eta_ = 0.01f * smoothing * smoothing;
+  scale_ = 2.0f * latticeVolume<Dim>(spacing, kernel_);  // 2 V of the component-wise Laplacian
+  maxError_ = static_cast<float>(scene.solver.viscosity_max_error);
+  maxIterations_ = scene.solver.viscosity_max_iterations;
+  float most = 0;
+  for (size_t f = 0; f < scene.fluids.size(); ++f) {
+    nu_.push_back(static_cast<float>(fluidViscosity(scene, f)));
+    most = std::max(most, nu_.back());
+  }
+  if (!implicit_) stableStep_ = 0.125f * smoothing * smoothing / most;
+  wallKeepTangent_ = static_cast<float>(1 - scene.viscous_slip);
+  for (const ColliderSettings& c : scene.colliders) keepTangent_.push_back(static_cast<float>(1 - c.viscous_slip));
+  for (const BodySettings& b : scene.bodies) keepTangent_.push_back(static_cast<float>(1 - b.solid.viscous_slip));
+
+  // The moments of x grad W^T / (|x|^2 + eta) over the lattice beyond a flat wall at distance d: their trace is
+  // the wall's share of sum_b F r^2 / (r^2 + eta).
+  const int reach = static_cast<int>(std::ceil(support / spacing)) + 1;
+  for (auto* table : {&wallTable_.weight, &wallTable_.gradient, &wallTable_.normalMoment, &wallTable_.tangentMoment})
+    table->assign(kWallTableSize + 1, 0.0f);
+  wallTable_.scale = kWallTableSize / support;
+  const auto none = [](const VecD&) { return 0.0f; };
+  const auto damped = [&](const VecD& r) -> VecD {
+    return kernel_.gradientFactor(r.norm()) / (r.squaredNorm() + eta_) * r;
+  };
+  for (int t = 0; t <= kWallTableSize; ++t) {
+    const float d[1] = {support * t / kWallTableSize};
+    double g[3], moments[4];
+    TankWalls<Dim>::sumBeyond(1, d, spacing, reach, none, damped, g, moments);
+    wallTable_.normalMoment[t] = static_cast<float>(moments[0]);
+    wallTable_.tangentMoment[t] = static_cast<float>(moments[1]);
+  }
+}
+
+template <int Dim>
+void Viscosity<Dim>::resize(size_t n) {
+  if (!implicit_) return;
+  for (auto& channel : warm_) channel.assign(n, 0.0f);
+}
+
+template <int Dim>
+size_t Viscosity<Dim>::memoryBytes() const {
+  size_t bytes = 0;
+  for (const auto& chunk : pairFactor_) bytes += chunk.capacity() * sizeof(float);
+  bytes += (wall_.capacity() + blockInverse_.capacity()) * sizeof(MatD);
+  for (const auto* channel : {&wallDrag_, &start_, &residual_, &direction_, &product_, &preconditioned_})
+    bytes += channel->capacity() * sizeof(VecD);
+  for (const auto& channel : warm_) bytes += channel.capacity() * sizeof(float);
+  return bytes;
+}
+
+template <int Dim>
+void Viscosity<Dim>::prepare(const std::vector<VecD>& x, const NeighborLists& neighbors, const TankWalls<Dim>& walls,
+                             const Colliders<Dim>& colliders, const std::vector<uint8_t>& fluid) {
+  const size_t n = x.size();
+  sizeForPairs(neighbors, pairFactor_);
+  wall_.resize(n);
+  wallDrag_.resize(n);
+  const VecD lower = walls.domainMin(), upper = walls.domainMax();
+  const float reach = kernel_.radius();
+  const bool several = !fluid.empty();
+  const bool colliding = !colliders.empty();
+  parallelFor(0, n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const VecD xi = x[i];
+      const float nuI = nu_[several ? fluid[i] : 0];
+      float* c = pairFactor_[i / NeighborLists::kChunk].data() + neighbors.start(i);
+      for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c) {
+        const VecD r = xi - x[*j];
+        const float nuIJ = several ? 0.5f * (nuI + nu_[fluid[*j]]) : nuI;
+        const float squared = r.squaredNorm();
+        *c = scale_ * nuIJ * kernel_.gradientFactor(std::sqrt(squared)) * squared / (squared + eta_);
+      }
+      // The boundary (eq. 11's b terms): each wall's weight sum_b 2 V nu F r^2 / (r^2 + eta), the normal moment
+      // and the tangential ones, on the normal part of the relative velocity and, kept by 1 - viscous_slip, on the
+      // tangential part.
+      MatD tensor = MatD::Zero();
+      VecD drag = VecD::Zero();
+      const auto addWall = [&](float d, const VecD& normal, float keepTangent, const VecD* wallVelocity) {
+        float normalMoment, tangentMoment;
+        wallTable_.moments(d, normalMoment, tangentMoment);
+        const MatD across = normal * normal.transpose();
+        const float weight = scale_ * nuI * (normalMoment + (Dim - 1) * tangentMoment);
+        const MatD wall = weight * (across + keepTangent * (MatD::Identity() - across));
+        tensor += wall;
+        if (wallVelocity) drag += wall * *wallVelocity;
+      };
+      for (int k = 0; k < Dim; ++k) {
+        if (xi[k] - lower[k] < reach) addWall(xi[k] - lower[k], VecD::Unit(k), wallKeepTangent_, nullptr);
+        if (upper[k] - xi[k] < reach) addWall(upper[k] - xi[k], -VecD::Unit(k), wallKeepTangent_, nullptr);
+      }
+      if (colliding)
+        colliders.forEachNear(xi, [&](size_t k, float d, const VecD& normal) {
+          const VecD moving = colliders.wallVelocity(k, xi);
+          addWall(d, normal, keepTangent_[k], &moving);
+        });
+      wall_[i] = tensor;
+      wallDrag_[i] = drag;
+    }
+  });
+}
+
+template <int Dim>
+void Viscosity<Dim>::laplacian(const std::vector<VecD>& u, const NeighborLists& neighbors,
+                               std::vector<VecD>& out) const {
+  out.resize(u.size());
+  parallelFor(0, u.size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const VecD ui = u[i];
+      VecD sum = wall_[i] * ui;
+      const float* c = pairFactor_[i / NeighborLists::kChunk].data() + neighbors.start(i);
+      for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c) sum += *c * (ui - u[*j]);
+      out[i] = sum;
+    }
+  });
+}
+
+template <int Dim>
+void Viscosity<Dim>::apply(const std::vector<VecD>& x, std::vector<VecD>& v, const NeighborLists& neighbors,
+                           const TankWalls<Dim>& walls, const Colliders<Dim>& colliders,
+                           const std::vector<uint8_t>& fluid, float dt) {
+  prepare(x, neighbors, walls, colliders, fluid);
+  if (implicit_) {
+    iterations_ = solveImplicit(x, v, neighbors, dt);
+    return;
+  }
+  // Explicit (Morris et al. 1997): v += dt (nu lap v - B v_b).
+  laplacian(v, neighbors, product_);
+  parallelFor(0, v.size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) v[i] += dt * (product_[i] - wallDrag_[i]);
+  });
+  iterations_ = 0;
+}
+
+// Eq. 12, (I - dt nu lap) v = v* - dt B v_b, by preconditioned conjugate gradients on A = I - dt (nu lap).
+template <int Dim>
+int Viscosity<Dim>::solveImplicit(const std::vector<VecD>& x, std::vector<VecD>& v, const NeighborLists& neighbors,
+                                  float dt) {
+  const size_t n = x.size();
+  start_.assign(v.begin(), v.end());  // v*
+  residual_.resize(n);
+  direction_.resize(n);
+  preconditioned_.resize(n);
+  blockInverse_.resize(n);
+  // The diagonal blocks of A: I - dt (sum_j c_ij x_ij x_ij^T + B_i), inverted (block Jacobi).
+  parallelFor(0, n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      float pairs = 0;
+      const float* c = pairFactor_[i / NeighborLists::kChunk].data() + neighbors.start(i);
+      for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c) pairs += *c;
+      const MatD block = wall_[i] + pairs * MatD::Identity();
+      blockInverse_[i] = (MatD::Identity() - dt * block).inverse();
+      v[i] = start_[i];  // the start: v* plus the last step's change
+      for (int k = 0; k < Dim; ++k) v[i][k] += warm_[k][i];
+    }
+  });
+  // r = b - A v, b = v* - dt B v_b.
+  laplacian(v, neighbors, product_);
+  parallelFor(0, n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      residual_[i] = start_[i] - dt * wallDrag_[i] - (v[i] - dt * product_[i]);
+      preconditioned_[i] = blockInverse_[i] * residual_[i];
+      direction_[i] = preconditioned_[i];
+    }
+  });
+  const double rightSide = parallelSum<double>(0, n, [&](size_t b, size_t e) {
+    double sum = 0;
+    for (size_t i = b; i < e; ++i) sum += double((start_[i] - dt * wallDrag_[i]).squaredNorm());
+    return sum;
+  });
+  const double limit = double(maxError_) * double(maxError_) * rightSide;
+  double rz = dot(residual_, preconditioned_);
+  int iterations = 0;
+  while (iterations < maxIterations_ && dot(residual_, residual_) > limit) {
+    laplacian(direction_, neighbors, product_);
+    parallelFor(0, n, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) product_[i] = direction_[i] - dt * product_[i];  // A p
+    });
+    const double curvature = dot(direction_, product_);
+    if (!(curvature > 0)) break;
+    const float alpha = static_cast<float>(rz / curvature);
+    parallelFor(0, n, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        v[i] += alpha * direction_[i];
+        residual_[i] -= alpha * product_[i];
+        preconditioned_[i] = blockInverse_[i] * residual_[i];
+      }
+    });
+    const double next = dot(residual_, preconditioned_);
+    const float beta = static_cast<float>(next / rz);
+    rz = next;
+    parallelFor(0, n, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) direction_[i] = preconditioned_[i] + beta * direction_[i];
+    });
+    ++iterations;
+  }
+  // The change of this step starts the next.
+  parallelFor(0, n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i)
+      for (int k = 0; k < Dim; ++k) warm_[k][i] = v[i][k] - start_[i][k];
+  });
+  return iterations;
+}
+
+template class Viscosity<2>;
+template class Viscosity<3>;
+
+}  // namespace surge
