@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -59,7 +60,7 @@ struct SolverSettings {
   // How fluids[i].viscosity acts (sim/viscosity.h): "implicit", "explicit", or "default": explicit for WCSPH,
   // implicit for the others.
   std::string viscosity_solver = "default";
-  double viscosity_max_error = 0.01;  // the implicit solve's relative residual |r| / |b|
+  double viscosity_max_error = 0.01;  // the implicit solve's residual over the step's viscous change
   int viscosity_max_iterations = 100;
 };
 
@@ -250,6 +251,7 @@ struct Scene {
   int dimensions = 3;
   Box domain;
   std::vector<std::string> open;  // domain.open: tank faces that are not walls (tankFaceNames)
+  std::vector<std::string> periodic;  // domain.periodic: axes ("x", "y", "z") along which the domain wraps
   double viscous_slip = 0;        // domain.viscous_slip: a viscous fluid along the tank's walls, 0 no slip
   double particle_spacing = 0;
   std::vector<FluidBlock> fluids;
@@ -282,6 +284,16 @@ struct Scene {
   double referenceDensity() const { return fluids.empty() ? solver.rest_density : fluids.front().rest_density; }
   // True when fluid can enter or leave: emitters, sinks or open faces.
   bool hasSources() const { return !emitters.empty() || !sinks.empty() || !open.empty(); }
+  // True when domain.periodic names `axis` (0 x, 1 y, 2 z).
+  bool isPeriodic(int axis) const {
+    return std::find(periodic.begin(), periodic.end(), std::string(1, char('x' + axis))) != periodic.end();
+  }
+  // The periodic axes as bits (1 << axis).
+  int periodicAxes() const {
+    int axes = 0;
+    for (int k = 0; k < 3; ++k) axes |= isPeriodic(k) << k;
+    return axes;
+  }
   // True when domain.open names the tank's face on `axis` (0 x, 1 y, 2 z), its upper side or its lower.
   bool isOpen(int axis, bool upper) const {
     const std::string face = std::string(upper ? "+" : "-") + char('x' + axis);

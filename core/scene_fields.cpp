@@ -181,6 +181,9 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.choices("open", s.open, tankFaceNames(),
               info("faces that are not walls (2D: -x, +x, -y, +y): a particle crossing one is removed, and the "
                    "renders leave it out"));
+    v.choices("periodic", s.periodic, {"x", "y", "z"},
+              info("axes along which the domain wraps (2D: x, y): a particle leaving one side enters the other, "
+                   "and neighbours, densities and the surface reach across the seam"));
     v.real("viscous_slip", s.viscous_slip,
            atLeast(0, "a viscous fluid (fluids[i].viscosity) along the walls: 0 sticks to them (no slip), 1 "
                       "slides freely", "", 1));
@@ -286,8 +289,8 @@ void visitScene(Scene& s, SceneVisitor& v) {
                   "conjugate gradients (no step limit); explicit, Morris et al. 1997 (dt <= 0.125 (h/2)^2 / nu); "
                   "default: explicit for WCSPH, implicit for the others (docs/viscosity.md)"));
     v.real("viscosity_max_error", s.solver.viscosity_max_error,
-           positive("the implicit viscosity solve stops when its residual over its right side, |r| / |b|, is "
-                    "under it"));
+           positive("the implicit viscosity solve stops when its residual is under this share of the step's "
+                    "viscous change, |r| <= e |b - A v*| (docs/viscosity.md)"));
     v.integer("viscosity_max_iterations", s.solver.viscosity_max_iterations,
               atLeast(1, "the most conjugate-gradient iterations of the implicit viscosity solve a step", "", 10000));
     FieldInfo cfl = positive("Courant number. WCSPH: dt <= cfl h / (c + |v|max), h = kernel_radius / 2; DFSPH: "

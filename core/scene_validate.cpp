@@ -251,6 +251,22 @@ WhitewaterScale whitewaterScale(const Scene& s) {
   return WhitewaterScale{speed, speed > 0 ? diagonal / speed : 0.0};
 }
 
+// domain.periodic: axes the scene has, not open, and at least three kernel radii long (the neighbour grid's
+// stencil of three cells must not meet itself across the seam, and a pair's nearest image must be unique).
+static void validatePeriodic(const Scene& s, const std::string& where) {
+  for (const std::string& axis : s.periodic) {
+    const int k = axis[0] - 'x';
+    if (k >= s.dimensions)
+      throw InputError(where, "domain.periodic", "'" + axis + "' does not exist in 2D (axes x, y)");
+    if (s.isOpen(k, false) || s.isOpen(k, true))
+      throw InputError(where, "domain.periodic", "'" + axis + "' has an open face (domain.open): a periodic axis has no faces");
+    if (s.domain.max[k] - s.domain.min[k] < 3 * s.solver.kernel_radius)
+      throw InputError(where, "domain.periodic",
+                       "the domain along " + axis + " must be at least 3 kernel radii (" +
+                           formatNumber(3 * s.solver.kernel_radius) + " m) to wrap");
+  }
+}
+
 void validateScene(Scene& s, const std::string& where) {
   // The default output folder is out/<name>: a scene file must not choose where Surge writes.
   if (!isPlainName(s.name))
@@ -277,6 +293,7 @@ void validateScene(Scene& s, const std::string& where) {
   for (int k = 0; k < d; ++k)
     if ((s.domain.max[k] - s.domain.min[k]) / solver.kernel_radius > double(1 << 20))
       throw InputError(where, "domain", "spans more than 2^20 kernel radii along an axis");
+  validatePeriodic(s, where);
 
   for (size_t i = 1; i < s.attractor.keyframes.size(); ++i)
     if (s.attractor.keyframes[i].time < s.attractor.keyframes[i - 1].time)

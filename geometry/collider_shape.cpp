@@ -140,6 +140,42 @@ Eigen::AlignedBox3d worldBounds(const ColliderShape& shape, const Pose& pose) {
   return world;
 }
 
+// Along a periodic axis (domain.periodic) a solid is not wrapped: it must stay a kernel radius clear of the seam
+// at every keyframe, or span the axis (a plate the length of the domain, which looks the same from either side).
+// Bodies move freely and are refused.
+static void checkPeriodicSeams(const Scene& scene, const ColliderSettings& c, const ColliderShape& s,
+                               const std::string& key, const std::string& where, bool body, float support) {
+  if (scene.periodicAxes() == 0) return;
+  if (body) throw InputError(where, key, "a body cannot cross a periodic seam: remove it or domain.periodic");
+  std::vector<double> times = {0.0};
+  for (const ColliderKeyframe& k : c.motion) times.push_back(k.time);
+  for (double time : times) {
+    const Pose pose = colliderPose(c, time);
+    for (int k = 0; k < scene.dimensions; ++k) {
+      if (!scene.isPeriodic(k)) continue;
+      double lo, hi;
+      if (s.kind == ShapeKind::Plane) {
+        const Eigen::Vector3d n = pose.rotation * s.planeNormal.cast<double>();
+        if (std::abs(n[k]) < 1e-9) continue;  // the plane runs along the axis
+        lo = hi = pose.translation[k];
+      } else {
+        const Eigen::AlignedBox3d world = worldBounds(s, pose);
+        lo = world.min()[k];
+        hi = world.max()[k];
+      }
+      const double min = scene.domain.min[k], max = scene.domain.max[k];
+      const bool inside = lo >= min + support && hi <= max - support;
+      const bool spans = lo <= min - support && hi >= max + support;
+      if (!inside && !spans) {
+        const std::string axis(1, char('x' + k));
+        throw InputError(where, key,
+                         "crosses the periodic seam along " + axis + " unclosed: keep it a kernel radius inside the "
+                         "domain along " + axis + " at every keyframe, or make it span the domain along " + axis);
+      }
+    }
+  }
+}
+
 ColliderShape buildSolidShape(const Scene& scene, const ColliderSettings& c, const std::string& key, bool body) {
   const std::string where = scene.source.empty() ? "scene" : scene.source;
   const float spacing = float(scene.particle_spacing);
@@ -176,6 +212,7 @@ ColliderShape buildSolidShape(const Scene& scene, const ColliderSettings& c, con
       if (world.min()[k] < domain.min()[k] - slack || world.max()[k] > domain.max()[k] + slack)
         throw InputError(where, key + ".position", "the body must start inside the domain");
   }
+  checkPeriodicSeams(scene, c, s, key, where, body, support);
   return s;
 }
 

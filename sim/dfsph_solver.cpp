@@ -82,7 +82,7 @@ long DfsphSolver<Dim>::step(float dt, double time) {
     divergenceIterations_ = solve(false, dt, maxDivergenceError_, 1, divergenceWarm_);
     if (!colliders_.empty()) recordColliderImpulses(divergenceWarm_, dt);
   }
-  return this->firstBadParticle();
+  return this->endStep();
 }
 
 template <int Dim>
@@ -119,6 +119,7 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
   if (colliding) wallFlux_.resize(n);
   const float selfWeight = kernel.value(0.0f);
   [[maybe_unused]] const float* inverse = inverseMassRatio_.data();  // w
+  this->periodic_.withNearestImage([&](const auto& wrap) {
   parallelFor(0, n, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const VecD xi = x_[i];
@@ -127,7 +128,8 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
       VecD* g = pairGradients_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
       float* w = xsphC_ > 0 ? pairWeights_[i / NeighborLists::kChunk].data() + neighbors_.start(i) : nullptr;
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++g) {
-        const VecD r = xi - x_[*j];
+        VecD r = xi - x_[*j];
+        wrap(r);
         const auto k = kernel.pair(r.norm());
         weight += k.value;
         if (w) *w++ = k.value;
@@ -158,6 +160,7 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
       if constexpr (kSeveral) own *= inverse[i];
       diagonal_[i] = own + squares;
     }
+  });
   });
 }
 

@@ -24,6 +24,8 @@ double asPrinted(double value, const char* format = "%.9g") {
 GravityPotential::GravityPotential(const Scene& scene) {
   const int d = scene.dimensions;
   gravity.head(d) = scene.gravity.head(d);
+  for (int k = 0; k < d; ++k)
+    if (scene.isPeriodic(k)) gravity[k] = 0;  // work instead (periodicGravityWork, sim/simulation.cpp)
   for (int k = 0; k < d; ++k) corner[k] = gravity[k] < 0 ? scene.domain.min[k] : scene.domain.max[k];
 }
 

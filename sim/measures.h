@@ -8,6 +8,7 @@
 
 #include "core/parallel.h"
 #include "sim/neighbor_grid.h"
+#include "sim/periodic.h"
 #include "sim/tank.h"
 
 namespace surge {
@@ -46,10 +47,12 @@ struct FluidMeasures {
 
 // The measures at positions x with neighbour lists of (nearly) those positions; weight(r2) is the density
 // kernel W as a function of the squared distance; walls.add(p, weight, gradient) adds the boundary's share.
-template <int Dim, typename Walls, typename Weight>
+// `wrap` takes a pair's offset to its nearest image (sim/periodic.h) in a domain that wraps.
+template <int Dim, typename Walls, typename Weight, typename Wrap = NoWrap>
 FluidMeasures measureDensityAndEnergy(const std::vector<Vec<Dim>>& x, const std::vector<Vec<Dim>>& v,
                                       const NeighborLists& neighbors, const Walls& walls, float mass,
-                                      float restDensity, Weight weight, const std::vector<float>& massRatio = {}) {
+                                      float restDensity, Weight weight, const std::vector<float>& massRatio = {},
+                                      const Wrap& wrap = {}) {
   struct Sums {
     double errorSum = 0, errorMax = 0, energy = 0;
     Sums& operator+=(const Sums& o) {
@@ -64,7 +67,11 @@ FluidMeasures measureDensityAndEnergy(const std::vector<Vec<Dim>>& x, const std:
     Sums s;
     for (size_t i = b; i < e; ++i) {
       float w = selfWeight;
-      for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) w += weight((x[i] - x[*j]).squaredNorm());
+      for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
+        Vec<Dim> r = x[i] - x[*j];
+        wrap(r);
+        w += weight(r.squaredNorm());
+      }
       Vec<Dim> unusedGradient = Vec<Dim>::Zero();
       walls.add(x[i], w, unusedGradient);
       const double error = std::max(double(mass * w / restDensity) - 1.0, 0.0);

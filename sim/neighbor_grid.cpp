@@ -181,6 +181,12 @@ void NeighborGrid<Dim>::sort(const std::vector<Vec<Dim>>& positions) {
   });
   uint64_t cells = 1;
   for (int k = 0; k < Dim; ++k) {
+    if (periodic_.periodic(k)) {  // the whole period, whatever the particles' box; the last cell takes the rest
+      origin_[k] = periodic_.min(k);
+      resolution_[k] = std::max<int64_t>(1, static_cast<int64_t>(std::floor(periodic_.period(k) * inverseCellSize_)));
+      cells *= static_cast<uint64_t>(resolution_[k]);
+      continue;
+    }
     const float lo = std::clamp(box.lo[k], domainMin_[k], domainMax_[k]);
     const float hi = std::clamp(box.hi[k], lo, domainMax_[k]);
     origin_[k] = n ? lo : domainMin_[k];
@@ -294,7 +300,8 @@ void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radi
           size_t used = 0;
           // The stencil's rows of candidates, kept while the particles (sorted by cell) stay in one cell.
           constexpr int kRows = Dim == 3 ? 25 : 5;  // rows of a stencil of reach 2
-          uint32_t rowBegin[kRows], rowEnd[kRows];
+          uint32_t rowBegin[2 * kRows], rowEnd[2 * kRows];  // a periodic row may split in two at the seam
+          Vec<Dim> rowShift[2 * kRows];                      // periodic: the image of the row's cells
           int rows = 0;
           size_t candidates = 0;
           Cell rowsCell;
@@ -302,7 +309,12 @@ void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radi
           for (size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
             const Vec<Dim> xi = x[i];
             const Cell cell = cellCoordinates(xi);
-            if (cell != rowsCell) {
+            if (cell != rowsCell && periodic_.active()) {
+              rowsCell = cell;
+              rows = periodicRuns(cell, reach, rowBegin, rowEnd, rowShift);
+              candidates = 0;
+              for (int row = 0; row < rows; ++row) candidates += rowEnd[row] - rowBegin[row];
+            } else if (cell != rowsCell) {
               rowsCell = cell;
               Cell lo = cell, hi = cell;
               for (int k = 0; k < Dim; ++k) {
@@ -332,14 +344,88 @@ void NeighborGrid<Dim>::findNeighbors(const std::vector<Vec<Dim>>& x, float radi
               chunk.resize(room);
             }
             uint32_t* out = chunk.data() + used;
-            for (int row = 0; row < rows; ++row)
-              out = keepInRange<Dim>(coordinates, n, xi, r2, static_cast<uint32_t>(i), rowBegin[row], rowEnd[row], out);
+            if (periodic_.active()) {
+              for (int row = 0; row < rows; ++row)
+                out = keepInRange<Dim>(coordinates, n, xi - rowShift[row], r2, static_cast<uint32_t>(i), rowBegin[row],
+                                       rowEnd[row], out);
+            } else {
+              for (int row = 0; row < rows; ++row)
+                out = keepInRange<Dim>(coordinates, n, xi, r2, static_cast<uint32_t>(i), rowBegin[row], rowEnd[row], out);
+            }
             used = static_cast<size_t>(out - chunk.data());
             lists.ends[i] = static_cast<uint32_t>(used);
           }
         }
       },
       1);
+}
+
+// The stencil of `cell` in a domain that wraps: for each row of cells along x within `reach`, the runs of slots
+// of its cells, a row split in two where it crosses the seam along x, each with the shift of its cells' image
+// near the cell (a whole period where the stencil wrapped). The runs come in increasing slot order, so the lists
+// stay in increasing index order. resolution_ >= 2 reach + 1 on a periodic axis, so no cell comes twice.
+template <int Dim>
+int NeighborGrid<Dim>::periodicRuns(const Cell& cell, int64_t reach, uint32_t* begin, uint32_t* end,
+                                    Vec<Dim>* shift) const {
+  // Along axis k, the stencil's cells as (first, last, image shift) segments of cells that do not wrap inside.
+  struct Segment {
+    int64_t first, last;
+    float shift;
+  };
+  auto segments = [&](int k, Segment* out) {
+    const int64_t lo = cell[k] - reach, hi = cell[k] + reach, res = resolution_[k];
+    if (!periodic_.periodic(k)) {
+      out[0] = {std::max<int64_t>(lo, 0), std::min<int64_t>(hi, res - 1), 0.0f};
+      return 1;
+    }
+    int count = 0;
+    const float period = periodic_.period(k);
+    if (lo < 0) out[count++] = {lo + res, res - 1, -period};
+    out[count++] = {std::max<int64_t>(lo, 0), std::min<int64_t>(hi, res - 1), 0.0f};
+    if (hi >= res) out[count++] = {0, hi - res, period};
+    return count;
+  };
+  Segment xs[3];
+  const int xCount = segments(0, xs);
+  int runs = 0;
+  auto addRows = [&](int64_t y, float yShift, int64_t z, float zShift) {
+    for (int a = 0; a < xCount; ++a) {
+      Cell first = cell, last = cell;
+      first[0] = xs[a].first;
+      last[0] = xs[a].last;
+      first[1] = last[1] = y;
+      if constexpr (Dim == 3) first[2] = last[2] = z;
+      slotsOfCells(linearIndex(first), linearIndex(last), begin[runs], end[runs]);
+      if (end[runs] == begin[runs]) continue;
+      shift[runs] = Vec<Dim>::Zero();
+      shift[runs][0] = xs[a].shift;
+      shift[runs][1] = yShift;
+      if constexpr (Dim == 3) shift[runs][2] = zShift;
+      ++runs;
+    }
+  };
+  Segment ys[3];
+  const int yCount = segments(1, ys);
+  auto addPlane = [&](int64_t z, float zShift) {
+    for (int b = 0; b < yCount; ++b)
+      for (int64_t y = ys[b].first; y <= ys[b].last; ++y) addRows(y, ys[b].shift, z, zShift);
+  };
+  if constexpr (Dim == 3) {
+    Segment zs[3];
+    const int zCount = segments(2, zs);
+    for (int c = 0; c < zCount; ++c)
+      for (int64_t z = zs[c].first; z <= zs[c].last; ++z) addPlane(z, zs[c].shift);
+  } else {
+    addPlane(0, 0.0f);
+  }
+  // Increasing slot order (the runs are disjoint): a few dozen at most, sorted by insertion.
+  for (int a = 1; a < runs; ++a)
+    for (int b = a; b > 0 && begin[b] < begin[b - 1]; --b) {
+      std::swap(begin[b], begin[b - 1]);
+      std::swap(end[b], end[b - 1]);
+      std::swap(shift[b], shift[b - 1]);
+    }
+  return runs;
 }
 
 template class NeighborGrid<2>;

@@ -17,6 +17,7 @@
 
 #include "core/parallel.h"
 #include "sim/kernels.h"
+#include "sim/periodic.h"
 
 namespace surge {
 
@@ -72,6 +73,9 @@ class NeighborGrid {
 
   // Cells of `cellSize`; positions outside [domainMin, domainMax] are clamped into the border cells.
   NeighborGrid(const Vec<Dim>& domainMin, const Vec<Dim>& domainMax, float cellSize);
+  // A domain that wraps (sim/periodic.h): the grid spans each periodic axis's period and neighbours are found
+  // across its seam, for positions inside the period (PeriodicDomain::wrap).
+  void setPeriodic(const PeriodicDomain<Dim>& periodic) { periodic_ = periodic; }
 
   // Sorts the particles into cells. Afterwards sortedOrder()[k] is the input index of the k-th particle in cell
   // order; the sort is stable, so equal inputs give equal orders whatever the thread count.
@@ -121,10 +125,12 @@ class NeighborGrid {
   using Cell = Eigen::Matrix<int64_t, Dim, 1>;
   Cell cellCoordinates(const Vec<Dim>& p) const;
   uint64_t linearIndex(const Cell& c) const;
+  int periodicRuns(const Cell& cell, int64_t reach, uint32_t* begin, uint32_t* end, Vec<Dim>* shift) const;
   // The sorted slots [begin, end) of the cells with linear indices [first, last].
   void slotsOfCells(uint64_t first, uint64_t last, uint32_t& begin, uint32_t& end) const;
 
   Vec<Dim> domainMin_, domainMax_;
+  PeriodicDomain<Dim> periodic_;
   float cellSize_, inverseCellSize_;
   Vec<Dim> origin_;
   Cell resolution_;

@@ -24,10 +24,12 @@ ParticleSolver<Dim>::ParticleSolver(const Scene& scene, std::shared_ptr<const Co
       attractor_(scene.attractor),
       tension_(scene, mass_),
       viscosity_(scene, static_cast<float>(scene.solver.kernel_radius)),
+      periodic_(scene),
       grid_(lattice.walls.domainMin(), lattice.walls.domainMax(),
             NeighborGrid<Dim>::cellSizeFor(static_cast<float>(scene.solver.kernel_radius))),
       walls_(std::move(lattice.walls)),
       sceneSpeedLimit_(static_cast<float>(runawaySpeed(scene))) {
+  grid_.setPeriodic(periodic_);
   if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
   if (scene.severalFluids()) {
     fluidMassRatio_.assign(scene.fluids.size(), 1.0f);

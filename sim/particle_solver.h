@@ -22,6 +22,7 @@
 #include "sim/kernels.h"
 #include "sim/measures.h"
 #include "sim/neighbor_grid.h"
+#include "sim/periodic.h"
 #include "sim/surface_tension.h"
 #include "sim/tank.h"
 #include "sim/viscosity.h"
@@ -36,17 +37,18 @@ void sizeChannel(std::vector<T>& channel, size_t n, const T& value) {
   channel.assign(n, value);
 }
 
-// The box the tank's walls stand on: the domain, with each open face (domain.open) moved out by two kernel
-// radii, where it reaches no particle inside the domain; a particle that crosses an open face is removed at the
-// end of its step (sim/sources.h).
+// The box the tank's walls stand on: the domain, with each open face (domain.open) and each face of a periodic
+// axis (domain.periodic) moved out by two kernel radii, where it reaches no particle inside the domain; a particle
+// that crosses an open face is removed at the end of its step (sim/sources.h), one that crosses a periodic face
+// is moved back in by a period (sim/periodic.h).
 template <int Dim>
 void tankWallBox(const Scene& scene, Vec<Dim>& lower, Vec<Dim>& upper) {
   lower = toVec<Dim>(scene.domain.min);
   upper = toVec<Dim>(scene.domain.max);
   const float margin = 2 * static_cast<float>(scene.solver.kernel_radius);
   for (int axis = 0; axis < Dim; ++axis) {
-    if (scene.isOpen(axis, false)) lower[axis] -= margin;
-    if (scene.isOpen(axis, true)) upper[axis] += margin;
+    if (scene.isOpen(axis, false) || scene.isPeriodic(axis)) lower[axis] -= margin;
+    if (scene.isOpen(axis, true) || scene.isPeriodic(axis)) upper[axis] += margin;
   }
 }
 
@@ -152,13 +154,19 @@ class ParticleSolver : public FluidSolver<Dim> {
   // as a function of the squared distance.
   template <typename Weight>
   FluidMeasures measureWith(Weight weight) const {
-    return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, Boundary<Dim>{walls_, colliders_}, mass_, restDensity_,
-                                        weight, massRatio_);
+    return periodic_.withNearestImage([&](const auto& wrap) {
+      return measureDensityAndEnergy<Dim>(x_, v_, neighbors_, Boundary<Dim>{walls_, colliders_}, mass_, restDensity_,
+                                          weight, massRatio_, wrap);
+    });
   }
   // The fastest particle's speed after `dt` of gravity: the CFL conditions' |v|max.
   float fastestAfterFall(float dt);
-  // The first particle that is not finite, left the tank or ran away (firstParticleOutside), or -1.
-  long firstBadParticle() const { return firstParticleOutside(x_, v_, walls_, speedLimit_); }
+  // The end of a method's step: positions that crossed a periodic face move back in by a period; then the
+  // first particle that is not finite, left the tank or ran away (firstParticleOutside), or -1.
+  long endStep() {
+    periodic_.wrap(x_);
+    return firstParticleOutside(x_, v_, walls_, speedLimit_);
+  }
   // Bytes held by the shared channels, the grid, the lists and the colliders (capacities).
   size_t coreMemoryBytes() const;
 
@@ -190,6 +198,7 @@ class ParticleSolver : public FluidSolver<Dim> {
   SurfaceTension<Dim> tension_;  // inactive without surface tension
   Viscosity<Dim> viscosity_;     // inactive without viscosity
 
+  const PeriodicDomain<Dim> periodic_;  // inactive without domain.periodic
   // The particles (structure of arrays), the grid, the walls and the colliders.
   std::vector<VecD> x_, v_;
   std::vector<uint32_t> id_;
@@ -224,6 +233,7 @@ class ParticleSolver : public FluidSolver<Dim> {
 template <int Dim>
 template <typename... Channels>
 void ParticleSolver<Dim>::reorderByCell(std::vector<VecD>& key, Channels&... channels) {
+  periodic_.wrap(key, &key != &x_ ? &x_ : nullptr);  // the grid takes positions inside the period
   grid_.sort(key);
   const std::vector<uint32_t>& order = grid_.sortedOrder();
   gatherByOrder(order, x_, vectorScratch_);

@@ -59,7 +59,8 @@ typename PbfSolver<Dim>::VecD PbfSolver<Dim>::colliderCorrection(size_t i, const
 // p_i - p_j, or coincidentOffset for a pair closer than coincidentLength_.
 template <int Dim>
 typename PbfSolver<Dim>::VecD PbfSolver<Dim>::pairOffset(size_t i, size_t j, const VecD& pi) const {
-  const VecD r = pi - p_[j];
+  VecD r = pi - p_[j];
+  if (this->periodic_.active()) this->periodic_(r);
   if (r.squaredNorm() <= coincidentLength_ * coincidentLength_) [[unlikely]] return coincidentOffset(i, j);
   return r;
 }

@@ -146,7 +146,7 @@ long PbfSolver<Dim>::step(float dt, double time) {
   if (vorticityEpsilon_ > 0) applyVorticityConfinement(dt);
   if (xsphC_ > 0) applyXsphViscosity();
   x_.swap(p_);  // line 23: x_i = x*_i
-  return this->firstBadParticle();
+  return this->endStep();
 }
 
 // Algorithm 1, lines 1-4: v_i += dt f_ext(x_i); x*_i = x_i + dt v_i. The walls act on x* at once. External
@@ -233,13 +233,16 @@ void PbfSolver<Dim>::applyWarmStart() {
 // above it (hydrostatic pressure) and a light fluid under a heavy one is pushed up.
 template <int Dim>
 double PbfSolver<Dim>::computeLambdas(float omega) {
-  return massRatio_.empty() ? computeLambdasOf<false>(omega) : computeLambdasOf<true>(omega);
+  if (this->periodic_.active())
+    return massRatio_.empty() ? computeLambdasOf<false, true>(omega) : computeLambdasOf<true, true>(omega);
+  return massRatio_.empty() ? computeLambdasOf<false, false>(omega) : computeLambdasOf<true, false>(omega);
 }
 
 template <int Dim>
-template <bool kSeveral>
+template <bool kSeveral, bool kPeriodic>
 double PbfSolver<Dim>::computeLambdasOf(float omega) {
   const float selfWeight = kernels_.poly6(0.0f);
+  [[maybe_unused]] const PeriodicDomain<Dim> periodic = this->periodic_;
   [[maybe_unused]] const float* inverse = inverseMassRatio_.data();  // w
   const double averageError = parallelSum<double>(0, size(), [&](size_t b, size_t e) {
     double errorSum = 0;
@@ -258,8 +261,9 @@ double PbfSolver<Dim>::computeLambdasOf(float omega) {
 #pragma omp simd simdlen(8) reduction(+ : w, g0, g1, g2, squares) reduction(| : coincident)
       for (int k = 0; k < count; ++k) {
         const size_t j = neighbor[k];
-        const float r0 = pi[0] - p[Dim * j], r1 = pi[1] - p[Dim * j + 1];
-        const float r2 = Dim == 3 ? pi[Dim - 1] - p[Dim * j + Dim - 1] : 0.0f;
+        float r0 = pi[0] - p[Dim * j], r1 = pi[1] - p[Dim * j + 1];
+        float r2 = Dim == 3 ? pi[Dim - 1] - p[Dim * j + Dim - 1] : 0.0f;
+        if constexpr (kPeriodic) periodic.nearest(r0, r1, r2);
         const float length2 = r0 * r0 + r1 * r1 + r2 * r2;
         coincident |= length2 <= coincidentLength_ * coincidentLength_;
         const auto pair = kernels_.pair(length2);
@@ -327,8 +331,9 @@ double PbfSolver<Dim>::computeLambdasOf(float omega) {
 //   rest spacing (unshifted, it swells a resting column) and acts only where lambda_i = lambda_j = 0, in spray
 //   and thin sheets (in compressed fluid it adds pressure that becomes kinetic energy).
 template <int Dim>
-template <bool kWarmStart>
-void PbfSolver<Dim>::applyPositionCorrections() {
+template <bool kWarmStart, bool kPeriodic>
+void PbfSolver<Dim>::applyPositionCorrectionsOf() {
+  [[maybe_unused]] const PeriodicDomain<Dim> periodic = this->periodic_;
   const bool scorr = scorrK_ > 0 && !kWarmStart;
   const bool sumLambdas = !kWarmStart && !lambdaTotal_.empty();
   std::vector<VecD>& corrections = vectorScratch_;  // applied after all are computed (Jacobi)
@@ -363,8 +368,9 @@ void PbfSolver<Dim>::applyPositionCorrections() {
 #pragma omp simd simdlen(8) reduction(+ : d0, d1, d2) reduction(| : coincident)
       for (int k = 0; k < count; ++k) {
         const size_t j = neighbor[k];
-        const float r0 = pi[0] - p[Dim * j], r1 = pi[1] - p[Dim * j + 1];
-        const float r2 = Dim == 3 ? pi[Dim - 1] - p[Dim * j + Dim - 1] : 0.0f;
+        float r0 = pi[0] - p[Dim * j], r1 = pi[1] - p[Dim * j + 1];
+        float r2 = Dim == 3 ? pi[Dim - 1] - p[Dim * j + Dim - 1] : 0.0f;
+        if constexpr (kPeriodic) periodic.nearest(r0, r1, r2);
         const float length2 = r0 * r0 + r1 * r1 + r2 * r2;
         coincident |= length2 <= coincident2;
         float coefficient = lambdaI + lambda[j];

@@ -74,13 +74,19 @@ class PbfSolver final : public ParticleSolver<Dim> {
   // Eq. 11 (with the Chebyshev weight omega of this iteration, 1 for plain Jacobi); returns the average density
   // error before this iteration's correction.
   double computeLambdas(float omega);
-  template <bool kSeveral>
+  template <bool kSeveral, bool kPeriodic>
   double computeLambdasOf(float omega);
   void applyWarmStart();
   // Eq. 12 from lambda_: an iteration's correction, or with kWarmStart the warm start's (kernel gradients
   // evaluated here rather than read from the lambda pass, no s_corr, nothing added to the lambda totals).
   template <bool kWarmStart>
-  void applyPositionCorrections();
+  void applyPositionCorrections() {
+    if (this->periodic_.active()) applyPositionCorrectionsOf<kWarmStart, true>();
+    else applyPositionCorrectionsOf<kWarmStart, false>();
+  }
+  // kPeriodic: pairs take their nearest image (sim/periodic.h); without it the loops are what they were.
+  template <bool kWarmStart, bool kPeriodic>
+  void applyPositionCorrectionsOf();
   void updateVelocities(float dt);
   void collide(size_t i, const VecD& from, bool fromStepStart);
   VecD colliderCorrection(size_t i, const VecD& p, float lambda);

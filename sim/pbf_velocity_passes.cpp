@@ -17,11 +17,13 @@ template <int Dim>
 void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
   const PhaseTimer timer(times_.vorticity);
   auto omegaMagnitude = [&](size_t j) { return Dim == 3 ? omega3_[j].norm() : std::abs(omega2_[j]); };
+  this->periodic_.withNearestImage([&](const auto& wrap) {
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       Eigen::Vector3f omega = Eigen::Vector3f::Zero();
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
-        const VecD r = p_[i] - p_[*j];
+        VecD r = p_[i] - p_[*j];
+        wrap(r);
         const VecD gradientJ = -kernels_.spikyGradient(r, r.norm());  // grad with respect to p_j
         Eigen::Vector3f vij = Eigen::Vector3f::Zero(), g = Eigen::Vector3f::Zero();
         vij.head<Dim>() = v_[*j] - v_[i];
@@ -37,7 +39,8 @@ void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
     for (size_t i = b; i < e; ++i) {
       VecD eta = VecD::Zero();
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
-        const VecD r = p_[i] - p_[*j];
+        VecD r = p_[i] - p_[*j];
+        wrap(r);
         eta += (omegaMagnitude(*j) - omegaMagnitude(i)) * kernels_.spikyGradient(r, r.norm());
       }
       const float etaLength = eta.norm();
@@ -50,6 +53,7 @@ void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
       v_[i] += dt * force.head<Dim>();
     }
   });
+  });
 }
 
 // Eq. 17: v_i <- v_i + c sum_j (m / rho_0) v_ij W(p_i - p_j, h), with v_ij = v_j - v_i. The factor m / rho_0
@@ -60,13 +64,18 @@ void PbfSolver<Dim>::applyXsphViscosity() {
   std::vector<VecD>& smoothed = vectorScratch_;
   smoothed.resize(size());
   const float scale = xsphC_ * massOverRho_;
-  parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      VecD sum = VecD::Zero();
-      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j)
-        sum += (v_[*j] - v_[i]) * kernels_.poly6((p_[i] - p_[*j]).squaredNorm());
-      smoothed[i] = v_[i] + scale * sum;
-    }
+  this->periodic_.withNearestImage([&](const auto& wrap) {
+    parallelFor(0, size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        VecD sum = VecD::Zero();
+        for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
+          VecD r = p_[i] - p_[*j];
+          wrap(r);
+          sum += (v_[*j] - v_[i]) * kernels_.poly6(r.squaredNorm());
+        }
+        smoothed[i] = v_[i] + scale * sum;
+      }
+    });
   });
   v_.swap(smoothed);
 }

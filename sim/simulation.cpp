@@ -93,6 +93,21 @@ double attractorWork(const Attractor<Dim>& attractor, const FluidSolver<Dim>& so
   return solver.particleMass() * work * dt;
 }
 
+// Gravity along a periodic axis (domain.periodic) has no floor to stand against: a particle that falls through
+// the seam comes back in on the other side. Its pull is work done on the fluid, counted as the attractor's is
+// above, and GravityPotential leaves it out.
+template <int Dim>
+double periodicGravityWork(const Vec<Dim>& g, const FluidSolver<Dim>& solver, float dt) {
+  const std::vector<Vec<Dim>>& v = solver.velocities();
+  const std::vector<float>& ratio = solver.massRatios();
+  const double work = parallelSum<double>(0, v.size(), [&](size_t b, size_t e) {
+    double sum = 0;
+    for (size_t i = b; i < e; ++i) sum += double(g.dot(v[i] + 0.5f * dt * g)) * (ratio.empty() ? 1.0f : ratio[i]);
+    return sum;
+  });
+  return solver.particleMass() * work * dt;
+}
+
 // The particles run() starts from: the newest frame of a resumed run (with the method's carried state and the
 // bodies' states there), or the scene's fluid less what lies inside colliders and bodies. Returns the initial
 // lattice's count, where the emitters' ids begin.
@@ -136,6 +151,8 @@ class FrameLoop final : public SimulationRun {
  public:
   FrameLoop(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir, bool resume)
       : scene_(scene), frameDuration_(1.0 / scene.output.fps), attractor_(scene.attractor) {
+    for (int k = 0; k < Dim; ++k)
+      if (scene.isPeriodic(k)) periodicGravity_[k] = static_cast<float>(scene.gravity[k]);
     // Everything below is made from the run's own copy of the scene, which lives as long as it does.
     removeStaleFiles(dir / "particles", !resume);
     removeStaleFiles(dir / "solver", !resume);
@@ -226,6 +243,7 @@ class FrameLoop final : public SimulationRun {
       }
       long badBody = -1;
       if (attractor_.active()) ledger.add(attractorWork(attractor_, solver, time, dt));
+      if (!periodicGravity_.isZero()) ledger.add(periodicGravityWork(periodicGravity_, solver, dt));
       const long bad = coupledStep<Dim>(solver, bodies_.get(), dt, time, badBody);
       time += dt;
       if (badBody >= 0)
@@ -295,6 +313,7 @@ class FrameLoop final : public SimulationRun {
   const Scene scene_;
   const double frameDuration_;
   const Attractor<Dim> attractor_;
+  Vec<Dim> periodicGravity_ = Vec<Dim>::Zero();  // gravity's components along the periodic axes
   std::unique_ptr<FluidSolver<Dim>> method_;
   std::unique_ptr<RigidBodies> bodies_;
   std::unique_ptr<FluidSources<Dim>> sources_;

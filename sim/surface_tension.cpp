@@ -93,6 +93,7 @@ SurfaceTension<Dim>::SurfaceTension(const Scene& scene, float mass) {
   if (sigma <= 0) return;
   const float spacing = static_cast<float>(scene.particle_spacing);
   spacing_ = spacing;
+  periodic_ = PeriodicDomain<Dim>(scene);
   support_ = static_cast<float>(scene.solver.kernel_radius);
   kernel_ = CubicSplineKernel<Dim>(support_);
   volume_ = latticeVolume<Dim>(spacing, kernel_);
@@ -200,12 +201,14 @@ void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const
   colour_.resize(n);
   normal_.resize(n);
   const float self = volume_ * kernel_.value(0);
+  periodic_.withNearestImage([&](const auto& wrap) {
   parallelFor(0, n, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       float c = self;
       VecD normal = VecD::Zero();
       for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
-        const VecD r = x[i] - x[*j];
+        VecD r = x[i] - x[*j];
+        wrap(r);
         const SphKernelPair k = kernel_.pair(r.norm());
         c += volume_ * k.value;
         normal += k.gradientFactor * r;
@@ -219,7 +222,8 @@ void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const
     for (size_t i = b; i < e; ++i) {
       VecD a = VecD::Zero();
       for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
-        const VecD r = x[i] - x[*j];
+        VecD r = x[i] - x[*j];
+        wrap(r);
         const float length = r.norm();
         VecD pair = normal_[*j] - normal_[i];  // eq. 4
         if (length > tiny) pair -= (mass_ * cohesion(length) / length) * r;  // eq. 1
@@ -235,6 +239,7 @@ void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const
         });
       accel_[i] = a;
     }
+  });
   });
 }
 

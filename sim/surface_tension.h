@@ -78,6 +78,7 @@ class SurfaceTension {
   double adhesionWorkPerBeta() const;
 
  private:
+  PeriodicDomain<Dim> periodic_;  // domain.periodic: pairs take their nearest image
   float cohesion(float r) const;  // C(r) of eq. 2
   float wallAdhesion(float d) const;  // sum_b V A(|x - x_b|) along the normal, a wall at d (table)
 

@@ -23,7 +23,9 @@
 // solved matrix-free by conjugate gradients preconditioned by the 2x2 or 3x3 diagonal blocks (block Jacobi: the
 // walls' slip couples a particle's components),
 // started from v* plus the last step's change (carried between frames, so --resume is exact), stopped when
-// |r| / |b| <= solver.viscosity_max_error (the paper's relative residual) or after viscosity_max_iterations.
+// |r| <= solver.viscosity_max_error |b - A v*| (the paper's relative residual taken against the step's viscous
+// change rather than |b|, so a fluid's uniform motion does not loosen it; the .cpp) or after
+// viscosity_max_iterations.
 // The matrix is symmetric (one volume V, nu_ij symmetric) and positive definite, so no step limit.
 // `explicit` (Morris 1997, WCSPH's default): v += dt nu lap v, stable for dt <= 0.125 (h/2)^2 / nu.
 // Every loop gathers and every dot product is a parallelSum: the same bytes at any thread count. A scene
@@ -82,6 +84,7 @@ class Viscosity {
   size_t memoryBytes() const;
 
  private:
+  PeriodicDomain<Dim> periodic_;  // domain.periodic: pairs take their nearest image
   // Per pair c_ij = 2 V nu_ij F_ij |x_ij|^2 / (|x_ij|^2 + eta), grad W_ij = F_ij x_ij; per particle the wall
   // tensor B_i (its share of the operator) and B_i v_b.
   void prepare(const std::vector<VecD>& x, const NeighborLists& neighbors, const TankWalls<Dim>& walls,
@@ -98,6 +101,7 @@ class Viscosity {
   std::vector<float> keepTangent_;  // by collider (bodies after the colliders): 1 - viscous_slip
   float wallKeepTangent_ = 1;       // the tank's
   FlatWallTable wallTable_;         // the moments of sum_b x_ib grad W_ib^T / (|x_ib|^2 + eta), by distance
+  FlatWallTable noSlipTable_;       // the same with each b's share times Morris's 1 + d_b / d_i (the tangential part)
   std::vector<std::vector<float>> pairFactor_;  // c_ij, parallel to the neighbour lists
   std::vector<MatD> wall_, blockInverse_;
   std::vector<VecD> wallDrag_;  // B_i v_b

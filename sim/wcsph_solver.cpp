@@ -114,7 +114,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
   // The fluids' own viscosity (sim/viscosity.h), explicit or implicit, on the step's end velocities.
   this->applyViscosity(x_, dt);
   time_ = time + dt;
-  return this->firstBadParticle();
+  return this->endStep();
 }
 
 template <int Dim>
@@ -147,11 +147,14 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
   const float* inverse = inverseMassRatio_.data();
   const float inverseSupport = 1.0f / support_;
   // Density by summation and the equation of state.
+  this->periodic_.withNearestImage([&](const auto& wrap) {
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       float weight = selfWeight, nearDensity = 0;
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
-        const float r = (x_[i] - x_[*j]).norm();
+        VecD offset = x_[i] - x_[*j];
+        wrap(offset);
+        const float r = offset.norm();
         weight += kernel.value(r);
         if (near) {
           const float d = std::max(1.0f - r * inverseSupport, 0.0f);
@@ -169,6 +172,7 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
       if (near) nearPressure_[i] = nearStiffness_ * nearDensity;
     }
   });
+  });
   framePressureMax_ = std::max(framePressureMax_, parallelMax(pressure_));
 
   // Forces, gathered per particle.
@@ -177,12 +181,14 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
   const float h = smoothingLength_;
   const float eta2 = 0.01f * h * h;
   const float laminar = 2.0f * (Dim + 2) * nu_;
+  this->periodic_.withNearestImage([&](const auto& wrap) {
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const float pressureTermI = pressure_[i] / (density_[i] * density_[i]);
       VecD pressureForce = VecD::Zero(), viscousForce = VecD::Zero(), nearForce = VecD::Zero();
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
-        const VecD r = x_[i] - x_[*j];
+        VecD r = x_[i] - x_[*j];
+        wrap(r);
         const float length = r.norm();
         const VecD gradient = kernel.gradientFactor(length) * r;
         pressureForce -= (pressureTermI + pressure_[*j] / (density_[*j] * density_[*j])) * gradient;
@@ -227,6 +233,7 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
       if (attractor_.active()) acceleration += attractor_.acceleration(x_[i], attractorAt);
       a_[i] = acceleration;
     }
+  });
   });
   // Surface tension and adhesion (sim/surface_tension.h), their adhesion recorded as forces with the others.
   if (this->tension_.active()) {

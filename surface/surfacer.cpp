@@ -367,8 +367,8 @@ FloatGrid::Ptr blendedLevelSet(const ParticleFrame& frame, const Parameters& p, 
 // go from 0.04 to 0.004 spacings rms in two steps; each step moves the surface by a third of a voxel times
 // its curvature in voxels), few enough to keep edges and small droplets.
 // With colliders, the water is extended into them before the smoothing and clipped by them at the end.
-FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene,
-                             const std::vector<SurfaceCollider>& colliders = {}) {
+FloatGrid::Ptr buildLevelSetOf(const ParticleFrame& frame, const Scene& scene,
+                               const std::vector<SurfaceCollider>& colliders) {
   initOpenVdb();
   const Parameters p = resolve(frame, scene);
   if (frame.size() == 0) return emptyLevelSet(p.voxel);
@@ -394,6 +394,56 @@ FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene,
   }
   if (!colliders.empty()) clipByColliders(*grid, colliders, double(grid->background()));
   Progress::checkInterrupt();
+  return grid;
+}
+
+// domain.periodic: the frame with the particles within `reach` of a periodic face copied a period over (both
+// faces of an axis, and on from the first axis's copies to the second's, so a corner gets its diagonal image).
+ParticleFrame withPeriodicImages(const ParticleFrame& frame, const Scene& scene, double reach) {
+  ParticleFrame out = frame;
+  for (int k = 0; k < scene.dimensions; ++k) {
+    if (!scene.isPeriodic(k)) continue;
+    const double lo = scene.domain.min[k], hi = scene.domain.max[k], period = hi - lo;
+    const size_t n = out.size();
+    for (size_t i = 0; i < n; ++i)
+      for (const double shift : {period, -period}) {
+        const double x = out.position[i][k];
+        if (shift > 0 ? x >= lo + reach : x <= hi - reach) continue;
+        out.position.push_back(out.position[i]);
+        out.position.back()[k] = float(x + shift);
+        out.velocity.push_back(out.velocity[i]);
+        out.id.push_back(out.id[i]);
+        if (!out.fluid.empty()) out.fluid.push_back(out.fluid[i]);
+      }
+  }
+  return out;
+}
+
+// The level set of a frame. On a periodic domain the particles' images across each seam make the surface run on
+// through it as the fluid does, and the faces of the periodic axes then cut it (as planes clip the water,
+// collider_clip.h): the surface meets each seam square, and matches the other side's there.
+FloatGrid::Ptr buildLevelSet(const ParticleFrame& frame, const Scene& scene,
+                             const std::vector<SurfaceCollider>& colliders = {}) {
+  if (scene.periodicAxes() == 0 || frame.size() == 0) return buildLevelSetOf(frame, scene, colliders);
+  const Parameters p = resolve(frame, scene);
+  // Beyond the kernel's support and the smoothing's reach a particle does not shape the surface at the seam.
+  const double reach = 3 * std::max(scene.solver.kernel_radius, 2 * p.spacing) + 2 * p.radius;
+  FloatGrid::Ptr grid = buildLevelSetOf(withPeriodicImages(frame, scene, reach), scene, colliders);
+  std::vector<SurfaceCollider> faces;
+  for (int k = 0; k < scene.dimensions; ++k) {
+    if (!scene.isPeriodic(k)) continue;
+    for (const int side : {1, -1}) {
+      SurfaceCollider face;
+      face.name = std::string(side > 0 ? "-" : "+") + char('x' + k);
+      face.plane = true;
+      openvdb::Vec3d normal(0, 0, 0);
+      normal[k] = side;  // into the domain: the solid is beyond the face
+      face.normal = normal;
+      face.offset = side > 0 ? scene.domain.min[k] : -scene.domain.max[k];
+      faces.push_back(face);
+    }
+  }
+  clipByColliders(*grid, faces, double(grid->background()));
   return grid;
 }
 

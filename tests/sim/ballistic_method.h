@@ -25,7 +25,7 @@ class BallisticSolver final : public ParticleSolver<Dim> {
     const auto external = this->externalForces(dt, time);
     for (size_t i = 0; i < this->size(); ++i) external.kick(this->x_[i], this->v_[i]);
     driftAgainstSolids(this->x_, this->v_, dt, this->mass_, this->massRatio_, this->colliders_, this->walls_);
-    return this->firstBadParticle();
+    return this->endStep();
   }
   FluidMeasures measure() override {
     this->reorderByCell(this->x_);

