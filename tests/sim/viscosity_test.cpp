@@ -81,7 +81,7 @@ Decay shearDecay(const std::string& method, double nu, double dt, const std::vec
 // Implicit, honey (nu 0.05) at steps 6.7 times the explicit limit 0.125 (h/2)^2 / nu (h = 2 spacings): after
 // the e-folding time the wave keeps exp(-1) of its amplitude within 5% (backward Euler's own lag at
 // nu k^2 dt = 0.02 is 1%; the component-wise Laplacian's lattice sum is 1% off its integral). Measured: PBF
-// +0.8%, WCSPH -4.1%. DFSPH keeps 0.44, a decay rate 0.82 of nu k^2, whatever the viscosity solve's tolerance
+// +0.9%, WCSPH +0.5%. DFSPH keeps 0.42, a decay rate 0.87 of nu k^2, whatever the viscosity solve's tolerance
 // (0.01 to 0.0001) or its own solvers' limits: its miss is held to its measure, 0.75 to 0.9 of the rate
 // (docs/viscosity.md).
 TEST(Viscosity, ShearWaveDecaysAtTheDiffusionRateImplicitly) {
