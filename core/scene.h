@@ -301,6 +301,8 @@ struct Scene {
       if (name == face) return true;
     return false;
   }
+  // True when the tank has a wall on that face: it is neither open nor on a periodic axis.
+  bool hasWall(int axis, bool upper) const { return !isOpen(axis, upper) && !isPeriodic(axis); }
 };
 
 // A collider or a body as the simulation left it for the later stages: its mesh in the world at time 0 in

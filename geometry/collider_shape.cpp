@@ -147,8 +147,14 @@ static void checkPeriodicSeams(const Scene& scene, const ColliderSettings& c, co
                                const std::string& key, const std::string& where, bool body, float support) {
   if (scene.periodicAxes() == 0) return;
   if (body) throw InputError(where, key, "a body cannot cross a periodic seam: remove it or domain.periodic");
+  // At time 0, at each keyframe and at 7 times between two (a translation moves the bounds linearly, so its
+  // keyframes decide; a rotation between keyframes can sweep a corner across the seam, seen at 1/8 of the turn).
   std::vector<double> times = {0.0};
-  for (const ColliderKeyframe& k : c.motion) times.push_back(k.time);
+  for (const ColliderKeyframe& k : c.motion) {
+    for (int step = 1; step < 8 && k.time > times.back(); ++step)
+      times.push_back(times.back() + (k.time - times.back()) / (9 - step));
+    times.push_back(k.time);
+  }
   for (double time : times) {
     const Pose pose = colliderPose(c, time);
     for (int k = 0; k < scene.dimensions; ++k) {
@@ -170,7 +176,7 @@ static void checkPeriodicSeams(const Scene& scene, const ColliderSettings& c, co
         const std::string axis(1, char('x' + k));
         throw InputError(where, key,
                          "crosses the periodic seam along " + axis + " unclosed: keep it a kernel radius inside the "
-                         "domain along " + axis + " at every keyframe, or make it span the domain along " + axis);
+                         "domain along " + axis + " at every time, or make it span the domain along " + axis);
       }
     }
   }

@@ -196,9 +196,10 @@ Shading Shading::fromScene(const Scene& scene) {
   s.skyZenith = r.sky_zenith.cast<float>();
   s.skyHorizon = r.sky_horizon.cast<float>();
   s.belowHorizon = 0.5f * s.skyHorizon;
-  s.waterAbsorption = absorptionOf(r.water_color, r.absorption_distance);
+  // The first fluid's colour (render.water_color unless it gives its own), or water's in a scene fed only by
+  // emitters.
+  s.waterAbsorption = absorptionOf(scene.fluids.empty() ? r.water_color : scene.fluids[0].color, r.absorption_distance);
   if (scene.severalFluids()) {  // in the order of the meshes: the first fluid's, then Scene::laterFluids
-    s.waterAbsorption = absorptionOf(scene.fluids[0].color, r.absorption_distance);
     s.fluidAbsorption.push_back(s.waterAbsorption);
     for (size_t b : scene.laterFluids()) s.fluidAbsorption.push_back(absorptionOf(scene.fluids[b].color, r.absorption_distance));
   }
@@ -512,16 +513,16 @@ std::vector<std::array<Eigen::Vector3f, 2>> tankEdges(const Scene& scene) {
   std::vector<std::array<Eigen::Vector3f, 2>> edges;
   if (scene.dimensions == 2) {
     const Eigen::Vector3f a(lo.x(), hi.y(), 0), b(lo.x(), lo.y(), 0), c(hi.x(), lo.y(), 0), d(hi.x(), hi.y(), 0);
-    if (!scene.isOpen(0, false)) edges.push_back({a, b});
-    if (!scene.isOpen(1, false)) edges.push_back({b, c});
-    if (!scene.isOpen(0, true)) edges.push_back({c, d});
+    if (scene.hasWall(0, false)) edges.push_back({a, b});
+    if (scene.hasWall(1, false)) edges.push_back({b, c});
+    if (scene.hasWall(0, true)) edges.push_back({c, d});
     return edges;
   }
   for (int axis = 0; axis < 3; ++axis) {
     const int a = (axis + 1) % 3, b = (axis + 2) % 3;
     for (int corner = 0; corner < 4; ++corner) {
       // The edge along `axis` lies on face a (upper when corner & 1) and face b (upper when corner & 2).
-      if (scene.isOpen(a, corner & 1) || scene.isOpen(b, corner & 2)) continue;
+      if (!scene.hasWall(a, corner & 1) || !scene.hasWall(b, corner & 2)) continue;
       Eigen::Vector3f p0 = lo, p1 = hi;
       p0[a] = p1[a] = (corner & 1) ? hi[a] : lo[a];
       p0[b] = p1[b] = (corner & 2) ? hi[b] : lo[b];

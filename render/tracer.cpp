@@ -188,7 +188,7 @@ RayScene::RayScene(const RayDevice& device, const TriangleMesh& water, const Sce
     for (int axis : {0, 2}) {
       const int across = 2 - axis;  // the other horizontal axis
       for (float at : {outerLo[axis], outerHi[axis]}) {
-        if (scene.isOpen(axis, at == outerHi[axis])) continue;  // an open face has no pane
+        if (!scene.hasWall(axis, at == outerHi[axis])) continue;  // an open or periodic face has no pane
         const auto base = static_cast<uint32_t>(glass.positions.size());
         for (int corner = 0; corner < 4; ++corner) {
           Eigen::Vector3f p;

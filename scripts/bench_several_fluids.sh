@@ -13,23 +13,12 @@ frames=${2:-60}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 scene=scenes/oil_and_water.json
-common=(--set output.frames="$frames" --set solver.substeps=8 --quiet)
-perstep() {  # perstep STATS COLUMN: ms a step over frames 1..N (wall_seconds in s, the ms_ columns in ms)
-  awk -F, -v c="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next }
-    $1 > 0 { sum += $col[c]; steps += $col["substeps"] }
-    END { printf "%.4f", (c == "wall_seconds" ? 1000 : 1) * sum / steps }' "$1"
-}
+common=(--set output.frames="$frames" --set solver.substeps=8)
+source "$(dirname "${BASH_SOURCE[0]}")/bench_steps.sh"
 best() {  # best NAME ARGS...: the fastest of three runs' ms a step, and its constraint phase's
-  local name=$1 fastest="" phase=""
+  local name=$1
   shift
-  for run in 1 2 3; do
-    "$surge" sim "$scene" --out "$work/$name" "${common[@]}" "$@"
-    local step; step=$(perstep "$work/$name/stats.csv" wall_seconds)
-    if [ -z "$fastest" ] || awk -v a="$step" -v b="$fastest" 'BEGIN { exit !(a < b) }'; then
-      fastest=$step phase=$(perstep "$work/$name/stats.csv" ms_constraint)
-    fi
-  done
-  echo "$fastest $phase"
+  fastest_of_three "$surge" "$work/$name" ms_constraint "$scene" "${common[@]}" "$@"
 }
 echo "| method | one fluid, ms a step | two fluids | ratio | pressure phase, one | two |"
 echo "|---|---|---|---|---|---|"

@@ -18,11 +18,7 @@ common=(--set output.frames="$frames" --set solver.method="$method" --set solver
   --set fluids[1].surface_tension=0 --set fluids[2].surface_tension=0
 # ms a step from stats.csv over frames 1..N: the whole step (wall_seconds), and the forces phase (ms_viscosity),
 # which holds the surface tension pass beside XSPH; and the solver's iterations a step.
-perstep() {  # perstep STATS COLUMN (wall_seconds in s, the ms_ columns in ms)
-  awk -F, -v c="$2" 'NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next }
-    $1 > 0 { sum += $col[c]; steps += $col["substeps"] }
-    END { printf "%.3f", (c == "wall_seconds" ? 1000 : 1) * sum / steps }' "$1"
-}
+source "$(dirname "${BASH_SOURCE[0]}")/bench_steps.sh"
 with=$(perstep "$work/with/stats.csv" wall_seconds) without=$(perstep "$work/without/stats.csv" wall_seconds)
 pass=$(perstep "$work/with/stats.csv" ms_viscosity) xsph=$(perstep "$work/without/stats.csv" ms_viscosity)
 mean() {  # mean STATS COLUMN over frames 1..N (iterations is already a step's mean in each frame)

@@ -119,8 +119,9 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
   if (colliding) wallFlux_.resize(n);
   const float selfWeight = kernel.value(0.0f);
   [[maybe_unused]] const float* inverse = inverseMassRatio_.data();  // w
-  this->periodic_.withNearestImage([&](const auto& wrap) {
+  this->periodic_.withNearestImage([&](const auto& sharedWrap) {
   parallelFor(0, n, [&](size_t b, size_t e) {
+    const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     for (size_t i = b; i < e; ++i) {
       const VecD xi = x_[i];
       float weight = selfWeight, squares = 0;

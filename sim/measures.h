@@ -47,12 +47,12 @@ struct FluidMeasures {
 
 // The measures at positions x with neighbour lists of (nearly) those positions; weight(r2) is the density
 // kernel W as a function of the squared distance; walls.add(p, weight, gradient) adds the boundary's share.
-// `wrap` takes a pair's offset to its nearest image (sim/periodic.h) in a domain that wraps.
+// `sharedWrap` takes a pair's offset to its nearest image (sim/periodic.h) in a domain that wraps.
 template <int Dim, typename Walls, typename Weight, typename Wrap = NoWrap>
 FluidMeasures measureDensityAndEnergy(const std::vector<Vec<Dim>>& x, const std::vector<Vec<Dim>>& v,
                                       const NeighborLists& neighbors, const Walls& walls, float mass,
                                       float restDensity, Weight weight, const std::vector<float>& massRatio = {},
-                                      const Wrap& wrap = {}) {
+                                      const Wrap& sharedWrap = {}) {
   struct Sums {
     double errorSum = 0, errorMax = 0, energy = 0;
     Sums& operator+=(const Sums& o) {
@@ -64,6 +64,7 @@ FluidMeasures measureDensityAndEnergy(const std::vector<Vec<Dim>>& x, const std:
   };
   const float selfWeight = weight(0.0f);
   const Sums sums = parallelSum<Sums>(0, x.size(), [&](size_t b, size_t e) {
+    const Wrap wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     Sums s;
     for (size_t i = b; i < e; ++i) {
       float w = selfWeight;

@@ -47,8 +47,8 @@ void tankWallBox(const Scene& scene, Vec<Dim>& lower, Vec<Dim>& upper) {
   upper = toVec<Dim>(scene.domain.max);
   const float margin = 2 * static_cast<float>(scene.solver.kernel_radius);
   for (int axis = 0; axis < Dim; ++axis) {
-    if (scene.isOpen(axis, false) || scene.isPeriodic(axis)) lower[axis] -= margin;
-    if (scene.isOpen(axis, true) || scene.isPeriodic(axis)) upper[axis] += margin;
+    if (!scene.hasWall(axis, false)) lower[axis] -= margin;
+    if (!scene.hasWall(axis, true)) upper[axis] += margin;
   }
 }
 
@@ -184,7 +184,7 @@ class ParticleSolver : public FluidSolver<Dim> {
   void applyViscosity(const std::vector<VecD>& at, float dt) {
     if (!viscosity_.active()) return;
     const PhaseTimer timer(times_.forces);
-    viscosity_.apply(at, v_, neighbors_, walls_, colliders_, fluid_, dt);
+    viscosity_.apply(at, v_, neighbors_, walls_, colliders_, fluid_, mass_, massRatio_, dt);
   }
 
   // Parameters, fixed at construction. restDensity_ and mass_ are fluid 0's (Scene::referenceDensity).

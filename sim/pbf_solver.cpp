@@ -242,9 +242,11 @@ template <int Dim>
 template <bool kSeveral, bool kPeriodic>
 double PbfSolver<Dim>::computeLambdasOf(float omega) {
   const float selfWeight = kernels_.poly6(0.0f);
-  [[maybe_unused]] const PeriodicDomain<Dim> periodic = this->periodic_;
   [[maybe_unused]] const float* inverse = inverseMassRatio_.data();  // w
   const double averageError = parallelSum<double>(0, size(), [&](size_t b, size_t e) {
+    // A copy of the thread's own: its periods stay in registers through the vectorised loop (read through the
+    // solver, the compiler must assume the loop's stores may change them, and gathers them lane by lane).
+    [[maybe_unused]] const PeriodicDomain<Dim> periodic = this->periodic_;
     double errorSum = 0;
     for (size_t i = b; i < e; ++i) {
       const VecD pi = p_[i];
@@ -333,13 +335,13 @@ double PbfSolver<Dim>::computeLambdasOf(float omega) {
 template <int Dim>
 template <bool kWarmStart, bool kPeriodic>
 void PbfSolver<Dim>::applyPositionCorrectionsOf() {
-  [[maybe_unused]] const PeriodicDomain<Dim> periodic = this->periodic_;
   const bool scorr = scorrK_ > 0 && !kWarmStart;
   const bool sumLambdas = !kWarmStart && !lambdaTotal_.empty();
   std::vector<VecD>& corrections = vectorScratch_;  // applied after all are computed (Jacobi)
   corrections.resize(size());
   const float scorrScale = scorrK_ / latticeGradientSum_;
   parallelFor(0, size(), [&](size_t b, size_t e) {
+    [[maybe_unused]] const PeriodicDomain<Dim> periodic = this->periodic_;  // the thread's own (computeLambdasOf)
     for (size_t i = b; i < e; ++i) {
       const VecD pi = p_[i];
       const float lambdaI = lambda_[i];

@@ -17,8 +17,9 @@ template <int Dim>
 void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
   const PhaseTimer timer(times_.vorticity);
   auto omegaMagnitude = [&](size_t j) { return Dim == 3 ? omega3_[j].norm() : std::abs(omega2_[j]); };
-  this->periodic_.withNearestImage([&](const auto& wrap) {
+  this->periodic_.withNearestImage([&](const auto& sharedWrap) {
   parallelFor(0, size(), [&](size_t b, size_t e) {
+    const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     for (size_t i = b; i < e; ++i) {
       Eigen::Vector3f omega = Eigen::Vector3f::Zero();
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
@@ -36,6 +37,7 @@ void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
     }
   });
   parallelFor(0, size(), [&](size_t b, size_t e) {
+    const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     for (size_t i = b; i < e; ++i) {
       VecD eta = VecD::Zero();
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
@@ -64,8 +66,9 @@ void PbfSolver<Dim>::applyXsphViscosity() {
   std::vector<VecD>& smoothed = vectorScratch_;
   smoothed.resize(size());
   const float scale = xsphC_ * massOverRho_;
-  this->periodic_.withNearestImage([&](const auto& wrap) {
+  this->periodic_.withNearestImage([&](const auto& sharedWrap) {
     parallelFor(0, size(), [&](size_t b, size_t e) {
+      const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
       for (size_t i = b; i < e; ++i) {
         VecD sum = VecD::Zero();
         for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {

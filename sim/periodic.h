@@ -5,7 +5,10 @@
 // one image within the kernel's support.
 //
 // A method's pair loop takes the offset through a functor chosen once per loop (withNearestImage): NoWrap in a
-// scene without periodic axes, so its loops compile to what they were, byte for byte and at the same speed.
+// scene without periodic axes, so its loops compile to what they were, byte for byte and at the same speed. Each
+// thread's body copies the functor into a local first: read through a reference, the compiler must assume the
+// loop's stores may change its periods and reloads them every pair (PBF's vectorised loops gathered them lane by
+// lane, and a periodic pool took 2.06 times a walled one's step; with the copy 1.0, docs/performance.md).
 #pragma once
 
 #include <cmath>
@@ -46,8 +49,13 @@ class PeriodicDomain {
   float period(int k) const { return period_[k]; }
   float min(int k) const { return min_[k]; }
 
-  // The nearest image of an offset's component k (the identity on an axis that does not wrap: period 0).
-  float component(int k, float r) const { return r - period_[k] * std::floor(r * inverse_[k] + 0.5f); }
+  // The nearest image of an offset's component k (the identity on an axis that does not wrap: period 0): less a
+  // period when over half of one, plus one when under minus half. For a pair, always within a period, that is
+  // r - period floor(r / period + 0.5) by two selects.
+  float component(int k, float r) const {
+    const float x = r * inverse_[k];
+    return x >= 0.5f ? r - period_[k] : x < -0.5f ? r + period_[k] : r;
+  }
   // The same on an offset held as components (a vectorised loop's; r2 is 0 in 2D and left so).
   void nearest(float& r0, float& r1, float& r2) const {
     r0 = component(0, r0);

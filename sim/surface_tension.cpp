@@ -201,8 +201,9 @@ void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const
   colour_.resize(n);
   normal_.resize(n);
   const float self = volume_ * kernel_.value(0);
-  periodic_.withNearestImage([&](const auto& wrap) {
+  periodic_.withNearestImage([&](const auto& sharedWrap) {
   parallelFor(0, n, [&](size_t b, size_t e) {
+    const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     for (size_t i = b; i < e; ++i) {
       float c = self;
       VecD normal = VecD::Zero();
@@ -219,6 +220,7 @@ void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const
   });
   const float tiny = 1e-6f * support_;
   parallelFor(0, n, [&](size_t b, size_t e) {
+    const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     for (size_t i = b; i < e; ++i) {
       VecD a = VecD::Zero();
       for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {

@@ -107,6 +107,21 @@ size_t Viscosity<Dim>::memoryBytes() const {
   return bytes;
 }
 
+// A wall's share of B_i at distance d along its normal: the weight sum_b 2 V nu F r^2 / (r^2 + eta) from the
+// normal moment and the tangential ones, on the normal part of the relative velocity and, kept by
+// 1 - viscous_slip, on the tangential part (the no-slip table's extrapolated boundary velocities).
+template <int Dim>
+typename Viscosity<Dim>::MatD Viscosity<Dim>::wallTensor(float d, const VecD& normal, float keepTangent,
+                                                         float nu) const {
+  float normalMoment, tangentMoment, noSlipNormal, noSlipTangent;
+  wallTable_.moments(d, normalMoment, tangentMoment);
+  noSlipTable_.moments(d, noSlipNormal, noSlipTangent);
+  const MatD across = normal * normal.transpose();
+  const float weight = scale_ * nu * (normalMoment + (Dim - 1) * tangentMoment);
+  const float noSlipWeight = scale_ * nu * (noSlipNormal + (Dim - 1) * noSlipTangent);
+  return weight * across + (keepTangent * noSlipWeight) * (MatD::Identity() - across);
+}
+
 template <int Dim>
 void Viscosity<Dim>::prepare(const std::vector<VecD>& x, const NeighborLists& neighbors, const TankWalls<Dim>& walls,
                              const Colliders<Dim>& colliders, const std::vector<uint8_t>& fluid) {
@@ -118,46 +133,37 @@ void Viscosity<Dim>::prepare(const std::vector<VecD>& x, const NeighborLists& ne
   const float reach = kernel_.radius();
   const bool several = !fluid.empty();
   const bool colliding = !colliders.empty();
+  periodic_.withNearestImage([&](const auto& sharedWrap) {
   parallelFor(0, n, [&](size_t b, size_t e) {
+    const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     for (size_t i = b; i < e; ++i) {
       const VecD xi = x[i];
       const float nuI = nu_[several ? fluid[i] : 0];
       float* c = pairFactor_[i / NeighborLists::kChunk].data() + neighbors.start(i);
       for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c) {
         VecD r = xi - x[*j];
-        if (periodic_.active()) periodic_(r);
+        wrap(r);
         const float nuIJ = several ? 0.5f * (nuI + nu_[fluid[*j]]) : nuI;
         const float squared = r.squaredNorm();
         *c = scale_ * nuIJ * kernel_.gradientFactor(std::sqrt(squared)) * squared / (squared + eta_);
       }
-      // The boundary (eq. 11's b terms): each wall's weight sum_b 2 V nu F r^2 / (r^2 + eta), the normal moment
-      // and the tangential ones, on the normal part of the relative velocity and, kept by 1 - viscous_slip, on the
-      // tangential part.
+      // The boundary (eq. 11's b terms): B_i, the walls' tensors summed, and B_i v_b.
       MatD tensor = MatD::Zero();
       VecD drag = VecD::Zero();
-      const auto addWall = [&](float d, const VecD& normal, float keepTangent, const VecD* wallVelocity) {
-        float normalMoment, tangentMoment, noSlipNormal, noSlipTangent;
-        wallTable_.moments(d, normalMoment, tangentMoment);
-        noSlipTable_.moments(d, noSlipNormal, noSlipTangent);
-        const MatD across = normal * normal.transpose();
-        const float weight = scale_ * nuI * (normalMoment + (Dim - 1) * tangentMoment);
-        const float noSlipWeight = scale_ * nuI * (noSlipNormal + (Dim - 1) * noSlipTangent);
-        const MatD wall = weight * across + (keepTangent * noSlipWeight) * (MatD::Identity() - across);
-        tensor += wall;
-        if (wallVelocity) drag += wall * *wallVelocity;
-      };
       for (int k = 0; k < Dim; ++k) {
-        if (xi[k] - lower[k] < reach) addWall(xi[k] - lower[k], VecD::Unit(k), wallKeepTangent_, nullptr);
-        if (upper[k] - xi[k] < reach) addWall(upper[k] - xi[k], -VecD::Unit(k), wallKeepTangent_, nullptr);
+        if (xi[k] - lower[k] < reach) tensor += wallTensor(xi[k] - lower[k], VecD::Unit(k), wallKeepTangent_, nuI);
+        if (upper[k] - xi[k] < reach) tensor += wallTensor(upper[k] - xi[k], -VecD::Unit(k), wallKeepTangent_, nuI);
       }
       if (colliding)
         colliders.forEachNear(xi, [&](size_t k, float d, const VecD& normal) {
-          const VecD moving = colliders.wallVelocity(k, xi);
-          addWall(d, normal, keepTangent_[k], &moving);
+          const MatD wall = wallTensor(d, normal, keepTangent_[k], nuI);
+          tensor += wall;
+          drag += wall * colliders.wallVelocity(k, xi);
         });
       wall_[i] = tensor;
       wallDrag_[i] = drag;
     }
+  });
   });
 }
 
@@ -176,16 +182,40 @@ void Viscosity<Dim>::laplacian(const std::vector<VecD>& u, const NeighborLists& 
   });
 }
 
+// Collider k's share of particle i's change, dt B_ik (v_i - v_b), is the impulse it gave i: recorded on k (its
+// drag in colliders.csv, a body's coupling, and the work a moving solid does for the energy ledger), at the
+// velocities the change was taken at (the solved ones implicit, the old ones explicit).
+template <int Dim>
+void Viscosity<Dim>::recordColliderDrag(const std::vector<VecD>& x, const std::vector<VecD>& v,
+                                        Colliders<Dim>& colliders, const std::vector<uint8_t>& fluid, float mass,
+                                        const std::vector<float>& massRatio, float dt) const {
+  const bool several = !fluid.empty();
+  parallelFor(0, x.size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const VecD xi = x[i];
+      const float nuI = nu_[several ? fluid[i] : 0];
+      const float m = several ? mass * massRatio[i] : mass;
+      colliders.forEachNear(xi, [&](size_t k, float d, const VecD& normal) {
+        const VecD relative = v[i] - colliders.wallVelocity(k, xi);
+        colliders.addImpulse(i, k, (m * dt) * (wallTensor(d, normal, keepTangent_[k], nuI) * relative), xi);
+      });
+    }
+  });
+}
+
 template <int Dim>
 void Viscosity<Dim>::apply(const std::vector<VecD>& x, std::vector<VecD>& v, const NeighborLists& neighbors,
-                           const TankWalls<Dim>& walls, const Colliders<Dim>& colliders,
-                           const std::vector<uint8_t>& fluid, float dt) {
+                           const TankWalls<Dim>& walls, Colliders<Dim>& colliders,
+                           const std::vector<uint8_t>& fluid, float mass, const std::vector<float>& massRatio,
+                           float dt) {
   prepare(x, neighbors, walls, colliders, fluid);
   if (implicit_) {
     iterations_ = solveImplicit(x, v, neighbors, dt);
+    if (!colliders.empty()) recordColliderDrag(x, v, colliders, fluid, mass, massRatio, dt);
     return;
   }
   // Explicit (Morris et al. 1997): v += dt (nu lap v - B v_b).
+  if (!colliders.empty()) recordColliderDrag(x, v, colliders, fluid, mass, massRatio, dt);
   laplacian(v, neighbors, product_);
   parallelFor(0, v.size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) v[i] += dt * (product_[i] - wallDrag_[i]);

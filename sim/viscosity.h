@@ -69,11 +69,12 @@ class Viscosity {
   // CG iterations of the last implicit solve (0 explicit).
   int lastIterations() const { return iterations_; }
 
-  // v at positions x (the neighbour lists of the method's support, in x's order), for a step dt. `fluid`: each
-  // particle's fluid block (empty: one fluid).
+  // v at positions x (the neighbour lists of the method's support, in x's order), for a step dt; the drag on
+  // each collider and body recorded on `colliders` as impulses. `fluid`: each particle's fluid block, and
+  // `massRatio` its mass over `mass` (both empty: one fluid).
   void apply(const std::vector<VecD>& x, std::vector<VecD>& v, const NeighborLists& neighbors,
-             const TankWalls<Dim>& walls, const Colliders<Dim>& colliders, const std::vector<uint8_t>& fluid,
-             float dt);
+             const TankWalls<Dim>& walls, Colliders<Dim>& colliders, const std::vector<uint8_t>& fluid, float mass,
+             const std::vector<float>& massRatio, float dt);
 
   // The implicit solve's warm start (its last change of velocity), one channel a component; none explicit.
   void forEachCarriedChannel(const std::function<void(std::vector<float>&)>& visit) {
@@ -89,6 +90,11 @@ class Viscosity {
   // tensor B_i (its share of the operator) and B_i v_b.
   void prepare(const std::vector<VecD>& x, const NeighborLists& neighbors, const TankWalls<Dim>& walls,
                const Colliders<Dim>& colliders, const std::vector<uint8_t>& fluid);
+  // A wall's share of B_i for a particle of viscosity nu at distance d along the wall's normal.
+  MatD wallTensor(float d, const VecD& normal, float keepTangent, float nu) const;
+  void recordColliderDrag(const std::vector<VecD>& x, const std::vector<VecD>& v, Colliders<Dim>& colliders,
+                          const std::vector<uint8_t>& fluid, float mass, const std::vector<float>& massRatio,
+                          float dt) const;
   // out_i = sum_j c_ij (u_i - u_j) + B_i u_i: nu lap u with the walls at rest.
   void laplacian(const std::vector<VecD>& u, const NeighborLists& neighbors, std::vector<VecD>& out) const;
   int solveImplicit(const std::vector<VecD>& x, std::vector<VecD>& v, const NeighborLists& neighbors, float dt);

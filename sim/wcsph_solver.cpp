@@ -113,6 +113,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
   }
   // The fluids' own viscosity (sim/viscosity.h), explicit or implicit, on the step's end velocities.
   this->applyViscosity(x_, dt);
+  if (colliding && this->viscosity_.active()) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);  // its drag
   time_ = time + dt;
   return this->endStep();
 }
@@ -147,8 +148,9 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
   const float* inverse = inverseMassRatio_.data();
   const float inverseSupport = 1.0f / support_;
   // Density by summation and the equation of state.
-  this->periodic_.withNearestImage([&](const auto& wrap) {
+  this->periodic_.withNearestImage([&](const auto& sharedWrap) {
   parallelFor(0, size(), [&](size_t b, size_t e) {
+    const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     for (size_t i = b; i < e; ++i) {
       float weight = selfWeight, nearDensity = 0;
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
@@ -181,8 +183,9 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
   const float h = smoothingLength_;
   const float eta2 = 0.01f * h * h;
   const float laminar = 2.0f * (Dim + 2) * nu_;
-  this->periodic_.withNearestImage([&](const auto& wrap) {
+  this->periodic_.withNearestImage([&](const auto& sharedWrap) {
   parallelFor(0, size(), [&](size_t b, size_t e) {
+    const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     for (size_t i = b; i < e; ++i) {
       const float pressureTermI = pressure_[i] / (density_[i] * density_[i]);
       VecD pressureForce = VecD::Zero(), viscousForce = VecD::Zero(), nearForce = VecD::Zero();

@@ -1,4 +1,5 @@
-// The tank's drawn edges leave its open faces out (domain.open): the path tracer's bars, the preview's lines.
+// The tank's drawn edges leave its open faces (domain.open) and the faces of its periodic axes (domain.periodic)
+// out: the path tracer's bars and glass panes, the preview's lines.
 #include <gtest/gtest.h>
 
 #include "render/shading.h"
@@ -28,6 +29,20 @@ TEST(TankEdges, AnOpenFaceTakesItsEdgesAway) {
   ASSERT_EQ(flat.size(), 1u);
   EXPECT_EQ(flat[0][0].x(), 2);
   EXPECT_EQ(flat[0][1].x(), 2);
+}
+
+TEST(TankEdges, APeriodicAxisHasNoWalls) {
+  Scene channel = tank(3, {});
+  channel.periodic = {"x"};
+  EXPECT_EQ(tankEdges(channel).size(), 4u);  // the fluid runs on through both x faces: the edges along x stay
+  for (const auto& [a, b] : tankEdges(channel)) EXPECT_NE(a.x(), b.x());
+  channel.periodic = {"x", "z"};
+  EXPECT_EQ(tankEdges(channel).size(), 0u);
+  Scene couette = tank(2, {});
+  couette.periodic = {"x"};
+  ASSERT_EQ(tankEdges(couette).size(), 1u);  // the floor only
+  EXPECT_EQ(tankEdges(couette)[0][0].y(), 0);
+  EXPECT_EQ(tankEdges(couette)[0][1].y(), 0);
 }
 
 }  // namespace

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# The cost of viscosity and of periodic axes (issue 35), each run beside its baseline in this script, the fastest
+# of three runs kept (a shared machine):
+# - viscosity: `honey` as it ships (nu = 0.05, implicit, DFSPH) beside the same scene with nu = 0, ms a step and
+#   the forces phase (stats.csv ms_viscosity: gravity, XSPH and the viscosity) a step;
+# - periodic axes: a 3D pool at rest (50 x 20 x 50 particles) periodic along x and z beside the same pool between
+#   walls, ms a step, in each method.
+#
+#   scripts/bench_viscosity.sh [SURGE_BINARY] [FRAMES]
+#   METHODS="pbf dfsph" scripts/bench_viscosity.sh ...   (the methods of the periodic runs)
+set -euo pipefail
+surge=${1:-build/apps/surge}
+frames=${2:-30}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/bench_steps.sh"
+best() {  # best SCENE ARGS...: the fastest of three runs' ms a step, and its forces phase's
+  fastest_of_three "$surge" "$work/run" ms_viscosity "$@" --set output.frames="$frames"
+}
+
+echo "| honey | ms a step | forces phase, ms a step |"
+echo "|---|---|---|"
+read -r with withPhase < <(best scenes/honey.json)
+read -r without withoutPhase < <(best scenes/honey.json --set 'fluids[0].viscosity=0')
+awk -v a="$without" -v b="$with" -v pa="$withoutPhase" -v pb="$withPhase" 'BEGIN {
+  printf "| nu = 0 | %.3f | %.3f |\n| nu = 0.05 | %.3f | %.3f |\n| ratio | %.3f | viscosity %.0f%% of a step |\n",
+         a, pa, b, pb, b / a, 100 * (pb - pa) / b }'
+
+cat >"$work/pool.json" <<'JSON'
+{"name": "pool", "dimensions": 3, "domain": {"min": [0, 0, 0], "max": [0.5, 0.3, 0.5]},
+ "particle_spacing": 0.01, "fluids": [{"box": {"min": [0, 0, 0], "max": [0.5, 0.2, 0.5]}}],
+ "output": {"fps": 30, "frames": 30}}
+JSON
+echo
+echo "| pool at rest | walls, ms a step | periodic x and z | ratio |"
+echo "|---|---|---|---|"
+for method in ${METHODS:-pbf dfsph wcsph}; do
+  read -r walled _ < <(best "$work/pool.json" --set solver.method="$method")
+  read -r periodic _ < <(best "$work/pool.json" --set solver.method="$method" --set 'domain.periodic=["x","z"]')
+  awk -v m="$method" -v a="$walled" -v b="$periodic" 'BEGIN { printf "| %s | %.3f | %.3f | %.3f |\n", m, a, b, b / a }'
+done
