@@ -6,22 +6,24 @@
 # - periodic axes: a 3D pool at rest (50 x 20 x 50 particles) periodic along x and z beside the same pool between
 #   walls, ms a step, in each method.
 #
-#   scripts/bench_viscosity.sh [SURGE_BINARY] [FRAMES]
+#   scripts/bench_viscosity.sh [SURGE_BINARY] [FRAMES] [POOL_FRAMES]   (defaults 30 and 10: WCSPH's pool takes
+#   about 5 s a frame)
 #   METHODS="pbf dfsph" scripts/bench_viscosity.sh ...   (the methods of the periodic runs)
 set -euo pipefail
 surge=${1:-build/apps/surge}
 frames=${2:-30}
+pool_frames=${3:-10}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/bench_steps.sh"
 best() {  # best SCENE ARGS...: the fastest of three runs' ms a step, and its forces phase's
-  fastest_of_three "$surge" "$work/run" ms_viscosity "$@" --set output.frames="$frames"
+  fastest_of_three "$surge" "$work/run" ms_viscosity "$@"
 }
 
 echo "| honey | ms a step | forces phase, ms a step |"
 echo "|---|---|---|"
-read -r with withPhase < <(best scenes/honey.json)
-read -r without withoutPhase < <(best scenes/honey.json --set 'fluids[0].viscosity=0')
+read -r with withPhase < <(best scenes/honey.json --set output.frames="$frames")
+read -r without withoutPhase < <(best scenes/honey.json --set output.frames="$frames" --set 'fluids[0].viscosity=0')
 awk -v a="$without" -v b="$with" -v pa="$withoutPhase" -v pb="$withPhase" 'BEGIN {
   printf "| nu = 0 | %.3f | %.3f |\n| nu = 0.05 | %.3f | %.3f |\n| ratio | %.3f | viscosity %.0f%% of a step |\n",
          a, pa, b, pb, b / a, 100 * (pb - pa) / b }'
@@ -35,7 +37,8 @@ echo
 echo "| pool at rest | walls, ms a step | periodic x and z | ratio |"
 echo "|---|---|---|---|"
 for method in ${METHODS:-pbf dfsph wcsph}; do
-  read -r walled _ < <(best "$work/pool.json" --set solver.method="$method")
-  read -r periodic _ < <(best "$work/pool.json" --set solver.method="$method" --set 'domain.periodic=["x","z"]')
+  read -r walled _ < <(best "$work/pool.json" --set output.frames="$pool_frames" --set solver.method="$method")
+  read -r periodic _ < <(best "$work/pool.json" --set output.frames="$pool_frames" --set solver.method="$method" \
+    --set 'domain.periodic=["x","z"]')
   awk -v m="$method" -v a="$walled" -v b="$periodic" 'BEGIN { printf "| %s | %.3f | %.3f | %.3f |\n", m, a, b, b / a }'
 done
