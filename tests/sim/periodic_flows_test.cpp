@@ -201,6 +201,32 @@ TEST(PeriodicFlows, ParticlesCrossTheSeamAndDensityRunsOnAcrossIt) {
   }
 }
 
+// A periodic channel with a block thrown along it into a viscous one, across the seam within the run, under a
+// plate spanning the period: the same bytes at 1 and 2 threads and resumed at frame 3 of 6, in every method (the
+// wrap happens at the end of each step, so a frame holds positions inside the domain). The plate stands still:
+// DFSPH resumed beside a moving collider is not exact yet, periodic or not (docs/reliability.md).
+TEST(PeriodicFlows, SameBytesAtAnyThreadCountAndAfterAResume) {
+  for (const std::string method : {"pbf", "dfsph", "wcsph"}) {
+    const std::string json = R"({"name": "wrap", "dimensions": 2,
+      "domain": {"min": [0, 0], "max": [0.4, 0.3], "periodic": ["x"]}, "particle_spacing": 0.02,
+      "fluids": [{"box": {"min": [0.2, 0], "max": [0.4, 0.2]}, "velocity": [1, 0]},
+                 {"name": "honey", "viscosity": 0.05, "box": {"min": [0, 0], "max": [0.2, 0.2]}}],
+      "colliders": [{"shape": "box", "size": [1.0, 0.04], "position": [0.2, 0.24]}],
+      "output": {"fps": 30, "frames": 6}})";
+    const std::vector<std::string> sets = {"solver.method=" + method};
+    const Scene scene = parseScene(json, "test", sets);
+    const std::string last = "particles/frame_00006.ply";
+    const std::string one = readTextFile(runScene(scene, "periodic_one_" + method, 1) / last);
+    const std::string two = readTextFile(runScene(scene, "periodic_two_" + method, 2) / last);
+    EXPECT_EQ(one, two) << method;
+    std::vector<std::string> shorter = sets;
+    shorter.push_back("output.frames=3");
+    runScene(parseScene(json, "test", shorter), "periodic_resumed_" + method, 2);
+    const std::string resumed = readTextFile(runScene(scene, "periodic_resumed_" + method, 2, true) / last);
+    EXPECT_EQ(one, resumed) << method;
+  }
+}
+
 // Bad input: z is no axis of a 2D scene; a periodic axis shorter than 3 kernel radii; an open face on a periodic
 // axis; a collider that crosses the seam without spanning it, at a keyframe or between two; whitewater, whose stage does not wrap. Each one
 // InputError naming the key.
