@@ -61,7 +61,14 @@ float DfsphSolver<Dim>::stableTimeStep() {
 
 template <int Dim>
 long DfsphSolver<Dim>::step(float dt, double time) {
+  // Keyframed colliders are placed as a step of this dt ending now leaves them (their pose now, their velocity
+  // over [time - dt, time]), from (time, dt) alone: the uninterrupted run and one resumed from a frame (whose
+  // colliders knew no step before) read the same walls in this step's forces and density solve. A scene with
+  // bodies keeps the last step's placement (their poses come per step from the coupling).
+  const bool keyframed = colliders_.anyMoving() && colliders_.firstBody() == colliders_.size();
+  if (keyframed) colliders_.beginStep(time - dt, dt);
   if (!prepared_) prepareStep();
+  else if (keyframed) updateWallFlux();
   applyNonPressureForces(dt, time);
 
   // Algorithm 3: the density solver on v*, then the move.
@@ -83,6 +90,23 @@ long DfsphSolver<Dim>::step(float dt, double time) {
     if (!colliders_.empty()) recordColliderImpulses(divergenceWarm_, dt);
   }
   return this->endStep();
+}
+
+template <int Dim>
+void DfsphSolver<Dim>::updateWallFlux() {
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const VecD xi = x_[i];
+      float flux = 0;
+      colliders_.forEachNear(xi, [&](size_t c, float d, const VecD& normal) {
+        float w;
+        VecD gradient;
+        colliders_.wallTerms(c, xi, d, normal, w, gradient);
+        flux += colliders_.wallVelocity(c, xi).dot(gradient);
+      });
+      wallFlux_[i] = volume_ * flux;
+    }
+  });
 }
 
 template <int Dim>

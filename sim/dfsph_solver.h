@@ -76,6 +76,8 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   // Sorts the particles into the grid (reordering every channel) and computes, at the current positions, the
   // neighbour lists, each pair's g_ij, each particle's wall gradient G_i, density ratio and S_i.
   void prepareStep();
+  // Each particle's wall flux (wallFlux_) at the current positions with the colliders as placed now.
+  void updateWallFlux();
   template <bool kSeveral, typename Kernel>
   void computeFactors(const Kernel& kernel);
   void applyNonPressureForces(float dt, double time);
