@@ -55,8 +55,6 @@ void runRenderStage(const Scene& scene, const fs::path& dir, const FrameRange& r
                     const std::string& renderer = "", bool resume = false);
 void runVideoStage(const Scene& scene, const fs::path& dir, const CommonOptions& options);
 
-// Removes the surface and render frames of an earlier run in dir (a new simulation makes them stale).
-void removeLaterStagesFrames(const fs::path& dir);
 // dir/sim_status.txt, one line the simulation keeps: "running", "finished", "stopped" (Ctrl-C, SIGTERM: a
 // requeue or --resume goes on) or "failed: " and the error. `surge surface --wait` reads it to know when to
 // give up. readSimStatus gives "" when there is none.

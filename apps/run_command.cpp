@@ -5,6 +5,7 @@
 #include "core/parallel.h"
 #include "sim/colliders.h"
 #include "sim/rigid_bodies.h"
+#include "sim/simulation.h"
 
 namespace surge {
 

@@ -2,7 +2,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
 #include "core/errors.h"
@@ -12,38 +11,6 @@
 #include "sim/solver_defaults.h"
 
 namespace surge {
-
-namespace {
-
-// A resumed simulation must go on with the physics it started with: the scene may change its name, its
-// surfacing, its rendering and its number of frames, nothing else. Throws InputError naming the first key
-// that differs from the folder's scene.json.
-void checkResumable(const fs::path& previous, const std::string& previousJson, const std::string& json) {
-  auto physics = [](nlohmann::json scene) {
-    for (const char* key : {"name", "surface", "render"}) scene.erase(key);
-    if (scene.contains("output")) scene["output"].erase("frames");
-    return scene;
-  };
-  const nlohmann::json patch = nlohmann::json::diff(physics(nlohmann::json::parse(previousJson)),
-                                                    physics(nlohmann::json::parse(json)));
-  if (patch.empty()) return;
-  std::string key = patch.front().value("path", "");
-  for (char& c : key) c = c == '/' ? '.' : c;
-  if (!key.empty() && key.front() == '.') key.erase(0, 1);
-  throw InputError(previous.string(), key,
-                   "differs from the scene this folder was simulated with; --resume needs the same physics "
-                   "(run without it to start over)");
-}
-
-}  // namespace
-
-void removeLaterStagesFrames(const fs::path& dir) {
-  // A new simulation: whatever the later stages made from an earlier one in this folder is stale (a shorter run
-  // would otherwise end in a video of the older run's later frames).
-  removeFrames(dir, "whitewater", {"ply"});
-  removeFrames(dir, "surface", {"vdb", "ply", "obj"});
-  removeFrames(dir, "frames", {"png"});
-}
 
 void writeSimStatus(const fs::path& dir, const std::string& status) {
   writeFileAtomically(dir / "sim_status.txt", [&](std::ostream& out) { out << status << "\n"; });
@@ -91,12 +58,7 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
     }
   }
   for (const std::string& note : solverNotes(scene)) say(options, "sim: note: " + note);
-  const std::string json = sceneToJson(scene);
   std::error_code error;
-  const bool existing = fs::exists(dir / "scene.json", error);
-  const std::string previous = existing ? readTextFile(dir / "scene.json") : std::string();
-  if (resume && existing && !listFrames(dir, "particles", "ply").empty())
-    checkResumable(dir / "scene.json", previous, json);
   // The particle frames still to write (28 bytes a particle and a header) must fit the disk: a run that would
   // fill it is refused now, not hours later. A resumed run writes the frames after its last one.
   const std::vector<int> written = resume ? listFrames(dir, "particles", "ply") : std::vector<int>{};
@@ -110,11 +72,7 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   }
   checkFreeSpace(dir, "--out", double(framesLeft) * (28.0 * double(mostParticles(scene)) + 512.0) - freed,
                  std::to_string(framesLeft) + " particle frames");
-  checkOutputFolder(dir);
-  if (!resume) removeLaterStagesFrames(dir);
-  // Rewritten only when it changes: its time tells the later stages' --resume whether their frames are stale.
-  if (!existing || previous != json)
-    writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << json; });
+  prepareSimulationFolder(scene, dir, resume);
   TerminalProgress progress(!options.quiet);
   writeSimStatus(dir, "running");
   SimulationSummary summary;

@@ -26,21 +26,6 @@ namespace py = pybind11;
 namespace surge {
 namespace {
 
-// A run's folder as `surge sim` leaves it: scene.json (the resolved scene the later stages read), rewritten only
-// when it changes, and a new run's later stages' frames removed as stale.
-void prepareFolder(const Scene& scene, const fs::path& dir, bool resume) {
-  checkOutputFolder(dir);
-  const std::string json = sceneToJson(scene);
-  std::error_code error;
-  const bool existing = fs::exists(dir / "scene.json", error);
-  if (!resume)
-    for (const auto& [sub, exts] : std::vector<std::pair<std::string, std::vector<std::string>>>{
-             {"whitewater", {"ply"}}, {"surface", {"vdb", "ply", "obj"}}, {"frames", {"png"}}})
-      removeFrames(dir, sub, exts);
-  if (!existing || readTextFile(dir / "scene.json") != json)
-    writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << json; });
-}
-
 class Simulation {
  public:
   Simulation(const std::string& scenePath, const std::vector<std::string>& overrides,
@@ -51,7 +36,7 @@ class Simulation {
     const ThreadLimit limit(threads_);
     const std::shared_ptr<const ColliderShapes> shapes = buildColliderShapes(scene);
     checkSimulationStart(scene, shapes);
-    prepareFolder(scene, dir_, resume);
+    prepareSimulationFolder(scene, dir_, resume);
     run_ = SimulationRun::start(scene, shapes, dir_, resume);
   }
 

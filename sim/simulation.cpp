@@ -12,6 +12,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "core/errors.h"
 #include "core/parallel.h"
 #include "core/scene_fields.h"
@@ -481,6 +483,45 @@ SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderSha
   summary.particles = run->size();
   summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - runStart).count();
   return summary;
+}
+
+// A resumed simulation must go on with the physics it started with: the scene may change its name, its
+// surfacing, its rendering and its number of frames, nothing else.
+static void checkResumable(const fs::path& previous, const std::string& previousJson, const std::string& json) {
+  auto physics = [](nlohmann::json scene) {
+    for (const char* key : {"name", "surface", "render"}) scene.erase(key);
+    if (scene.contains("output")) scene["output"].erase("frames");
+    return scene;
+  };
+  const nlohmann::json patch = nlohmann::json::diff(physics(nlohmann::json::parse(previousJson)),
+                                                    physics(nlohmann::json::parse(json)));
+  if (patch.empty()) return;
+  std::string key = patch.front().value("path", "");
+  for (char& c : key) c = c == '/' ? '.' : c;
+  if (!key.empty() && key.front() == '.') key.erase(0, 1);
+  throw InputError(previous.string(), key,
+                   "differs from the scene this folder was simulated with; --resume needs the same physics "
+                   "(run without it to start over)");
+}
+
+void removeLaterStagesFrames(const fs::path& dir) {
+  // A shorter run would otherwise end in a video of the older run's later frames.
+  removeFrames(dir, "whitewater", {"ply"});
+  removeFrames(dir, "surface", {"vdb", "ply", "obj"});
+  removeFrames(dir, "frames", {"png"});
+}
+
+void prepareSimulationFolder(const Scene& scene, const fs::path& dir, bool resume) {
+  const std::string json = sceneToJson(scene);
+  std::error_code error;
+  const bool existing = fs::exists(dir / "scene.json", error);
+  const std::string previous = existing ? readTextFile(dir / "scene.json") : std::string();
+  if (resume && existing && !listFrames(dir, "particles", "ply").empty())
+    checkResumable(dir / "scene.json", previous, json);
+  checkOutputFolder(dir);
+  if (!resume) removeLaterStagesFrames(dir);
+  if (!existing || previous != json)
+    writeFileAtomically(dir / "scene.json", [&](std::ostream& out) { out << json; });
 }
 
 }  // namespace surge

@@ -22,6 +22,15 @@ ParticleFrame initialParticles(const Scene& scene);
 // sinks that hold the whole initial fluid.
 void checkSimulationStart(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes);
 
+// Makes `dir` ready for a simulation of `scene`, as `surge sim` and the Python module both do: resumed over
+// particle frames, the folder's scene.json must have the same physics (InputError naming the first key that
+// differs; the name, surfacing, rendering and frame count may change); a new run removes the later stages' frames
+// of an earlier one (removeLaterStagesFrames); scene.json is rewritten only when it changes (its time tells the
+// later stages' --resume whether their frames are stale).
+void prepareSimulationFolder(const Scene& scene, const fs::path& dir, bool resume);
+// Removes the whitewater, surface and render frames of an earlier run in dir (a new simulation makes them stale).
+void removeLaterStagesFrames(const fs::path& dir);
+
 struct SimulationSummary {
   int firstFrame = 0;  // the frame the run started from (0, or the frame it resumed from)
   int lastFrame = 0;

@@ -78,3 +78,17 @@ def test_bad_input_names_the_file_or_key(tmp_path):
         surge.Simulation(SCENE, ["solver.iterations=-3"], out=str(tmp_path / "bad"))
     with pytest.raises(ValueError, match="scene.json"):
         surge.surface(str(tmp_path / "nothing_here"))
+
+
+def test_a_resume_goes_on_only_with_the_physics_it_started_with(tmp_path):
+    # As `surge sim --resume`: the folder's scene must have the same physics; more frames may be asked for.
+    sim = surge.Simulation(SCENE, ["output.frames=1"], out=str(tmp_path))
+    while sim.step_frame():
+        pass
+    with pytest.raises(ValueError, match="solver.iterations"):
+        surge.Simulation(SCENE, ["output.frames=2", "solver.iterations=3"], out=str(tmp_path), resume=True)
+    sim = surge.Simulation(SCENE, ["output.frames=2"], out=str(tmp_path), resume=True)
+    assert sim.frame == 1
+    while sim.step_frame():
+        pass
+    assert frames(tmp_path) == ["frame_00000.ply", "frame_00001.ply", "frame_00002.ply"]
