@@ -93,18 +93,26 @@ long DfsphSolver<Dim>::step(float dt, double time) {
 }
 
 template <int Dim>
+float DfsphSolver<Dim>::colliderTerms(const VecD& xi, float& weight, VecD& gradient) const {
+  float flux = 0;
+  colliders_.forEachNear(xi, [&](size_t c, float d, const VecD& normal) {
+    float w;
+    VecD g;
+    colliders_.wallTerms(c, xi, d, normal, w, g);
+    weight += w;
+    gradient += g;
+    flux += colliders_.wallVelocity(c, xi).dot(g);
+  });
+  return flux;
+}
+
+template <int Dim>
 void DfsphSolver<Dim>::updateWallFlux() {
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
-      const VecD xi = x_[i];
-      float flux = 0;
-      colliders_.forEachNear(xi, [&](size_t c, float d, const VecD& normal) {
-        float w;
-        VecD gradient;
-        colliders_.wallTerms(c, xi, d, normal, w, gradient);
-        flux += colliders_.wallVelocity(c, xi).dot(gradient);
-      });
-      wallFlux_[i] = volume_ * flux;
+      float unusedWeight = 0;
+      VecD unusedGradient = VecD::Zero();
+      wallFlux_[i] = volume_ * colliderTerms(x_[i], unusedWeight, unusedGradient);
     }
   });
 }
@@ -166,18 +174,7 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
       float wallWeight = 0;
       VecD wall = VecD::Zero();
       walls_.add(xi, wallWeight, wall);
-      if (colliding) {
-        float flux = 0;
-        colliders_.forEachNear(xi, [&](size_t c, float d, const VecD& normal) {
-          float w;
-          VecD gradient;
-          colliders_.wallTerms(c, xi, d, normal, w, gradient);
-          wallWeight += w;
-          wall += gradient;
-          flux += colliders_.wallVelocity(c, xi).dot(gradient);
-        });
-        wallFlux_[i] = volume_ * flux;
-      }
+      if (colliding) wallFlux_[i] = volume_ * colliderTerms(xi, wallWeight, wall);
 
       wallGradient_[i] = volume_ * wall;
       densityRatio_[i] = volume_ * (weight + wallWeight);

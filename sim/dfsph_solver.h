@@ -76,6 +76,9 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   // Sorts the particles into the grid (reordering every channel) and computes, at the current positions, the
   // neighbour lists, each pair's g_ij, each particle's wall gradient G_i, density ratio and S_i.
   void prepareStep();
+  // The colliders near xi: adds their weight and gradient sums (wallTerms) and returns sum_c v_c . grad W, the
+  // flux a moving wall drives into the particle (wallFlux_ over the volume).
+  float colliderTerms(const VecD& xi, float& weight, VecD& gradient) const;
   // Each particle's wall flux (wallFlux_) at the current positions with the colliders as placed now.
   void updateWallFlux();
   template <bool kSeveral, typename Kernel>

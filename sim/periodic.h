@@ -24,7 +24,6 @@ namespace surge {
 struct NoWrap {
   template <typename V>
   void operator()(V&) const {}
-  float component(int, float r) const { return r; }
 };
 
 template <int Dim>
@@ -44,7 +43,6 @@ class PeriodicDomain {
   }
 
   bool active() const { return axes_ != 0; }
-  int axes() const { return axes_; }
   bool periodic(int k) const { return axes_ >> k & 1; }
   float period(int k) const { return period_[k]; }
   float min(int k) const { return min_[k]; }
@@ -73,17 +71,6 @@ class PeriodicDomain {
     return f(*this);
   }
 
-  // The whole periods that bring p into [min, min + period) on the periodic axes (zero elsewhere).
-  VecD shiftInto(const VecD& p) const {
-    VecD shift = VecD::Zero();
-    for (int k = 0; k < Dim; ++k)
-      if (periodic(k)) {
-        const float periods = std::floor((p[k] - min_[k]) * inverse_[k]);
-        if (periods != 0 && std::isfinite(periods)) shift[k] = -periods * period_[k];
-      }
-    return shift;
-  }
-
   // Moves every position of `key` back into the domain, and each of `also` (positions of the same particles
   // taken at another time, or empty) by the same periods, so differences between them stay as they were.
   void wrap(std::vector<VecD>& key, std::vector<VecD>* also = nullptr) const {
@@ -102,6 +89,17 @@ class PeriodicDomain {
   }
 
  private:
+  // The whole periods that bring p into [min, min + period) on the periodic axes (zero elsewhere).
+  VecD shiftInto(const VecD& p) const {
+    VecD shift = VecD::Zero();
+    for (int k = 0; k < Dim; ++k)
+      if (periodic(k)) {
+        const float periods = std::floor((p[k] - min_[k]) * inverse_[k]);
+        if (periods != 0 && std::isfinite(periods)) shift[k] = -periods * period_[k];
+      }
+    return shift;
+  }
+
   int axes_ = 0;
   float min_[3] = {0, 0, 0}, period_[3] = {0, 0, 0}, inverse_[3] = {0, 0, 0};
 };
