@@ -261,7 +261,8 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.integer("substeps", s.solver.substeps,
               atLeast(0, "PBF: the fewest time steps per output frame, each shortened when the fluid needs it (the "
                          "CFL step, and dt <= 0.9 particle_spacing / sqrt(g depth) on its deepest column); WCSPH "
-                         "chooses its own, see time_step; DFSPH takes at least this many, from its CFL step; 0: 4, or more if the pool the fluid settles into is "
+                         "chooses its own, see time_step; DFSPH takes at least this many, from its CFL step and the same depth "
+                         "limit; 0: 4, or more if the pool the fluid settles into is "
                          "deep enough to need them (dt <= 0.9 particle_spacing / sqrt(g depth)) or an emitter fast "
                          "enough to (its jet moves at most half a spacing a step)", "", 100000));
     v.real("kernel_radius", s.solver.kernel_radius,

@@ -121,10 +121,11 @@ void validateFluids(Scene& s, const std::string& where) {
                        formatNumber(fluid.viscosity) + " differs from fluids[" + std::to_string(s.fluidOf(i)) +
                            "]'s " + formatNumber(first.viscosity) + ", a block of the same fluid '" + fluid.name +
                            "': give it another name");
-    if (fluid.name != s.fluids[0].name && i == s.fluidOf(i)) {  // the scene's second fluid, or a later one
-      if (fluid.surface_tension > 0 || s.fluids[0].surface_tension > 0)
-        throw InputError(where, key + ".surface_tension", "surface tension with several fluids is not built yet");
-    }
+    if (fluid.surface_tension != first.surface_tension)
+      throw InputError(where, key + ".surface_tension",
+                       formatNumber(fluid.surface_tension) + " differs from fluids[" + std::to_string(s.fluidOf(i)) +
+                           "]'s " + formatNumber(first.surface_tension) + ", a block of the same fluid '" +
+                           fluid.name + "': give it another name");
     const Box& b = fluid.box;
     if (fluid.shaped()) {
       const std::string& shape = fluid.solid.shape;
@@ -142,11 +143,6 @@ void validateFluids(Scene& s, const std::string& where) {
       if (b.min[k] < s.domain.min[k] || b.max[k] > s.domain.max[k])
         throw InputError(where, key + ".box", "lies outside the domain");
     }
-    // One fluid a scene for now: its blocks share the surface tension.
-    if (i > 0 && fluid.surface_tension != s.fluids[0].surface_tension)
-      throw InputError(where, key + ".surface_tension",
-                       "differs from fluids[0]'s " + formatNumber(s.fluids[0].surface_tension) +
-                           ": the blocks of a scene are one fluid and share it");
   }
 }
 

@@ -30,6 +30,17 @@ ParticleSolver<Dim>::ParticleSolver(const Scene& scene, std::shared_ptr<const Co
       walls_(std::move(lattice.walls)),
       sceneSpeedLimit_(static_cast<float>(runawaySpeed(scene))) {
   grid_.setPeriodic(periodic_);
+  latticeSpacing_ = static_cast<float>(scene.particle_spacing);
+  gravity_.cwiseAbs().maxCoeff(&down_);
+  floorMin_ = toVec<Dim>(scene.domain.min);
+  columns_.setOnes();
+  columnWidth_ = toVec<Dim>(scene.domain.max - scene.domain.min);
+  for (int k = 0; k < Dim; ++k) {
+    if (k == down_) continue;
+    columns_[k] = std::max(1, int(std::lround(columnWidth_[k] / (kColumnSpacings * latticeSpacing_))));
+    columnWidth_[k] /= float(columns_[k]);
+    columnArea_ *= columnWidth_[k];
+  }
   if (hasSolids(scene)) colliders_ = Colliders<Dim>(scene, std::move(shapes), walls_);
   if (scene.severalFluids()) {
     fluidMassRatio_.assign(scene.fluids.size(), 1.0f);
@@ -141,6 +152,26 @@ float ParticleSolver<Dim>::fastestAfterFall(float dt) {
     for (size_t i = b; i < e; ++i) speeds[i] = (v_[i] + fall).norm();
   });
   return parallelMax(speeds);
+}
+
+// Counting is a pass over the particles in order, the same at any thread count.
+template <int Dim>
+float ParticleSolver<Dim>::depthStableStepNow() {
+  const float g = gravity_.norm();
+  if (!(g > 0) || size() == 0) return INFINITY;
+  columnCounts_.assign(size_t(columns_.prod()), 0);
+  for (const VecD& p : x_) {
+    size_t cell = 0;
+    for (int k = Dim - 1; k >= 0; --k) {
+      if (k == down_) continue;
+      const int c = std::clamp(int((p[k] - floorMin_[k]) / columnWidth_[k]), 0, columns_[k] - 1);
+      cell = cell * size_t(columns_[k]) + size_t(c);
+    }
+    ++columnCounts_[cell];
+  }
+  const uint32_t most = *std::max_element(columnCounts_.begin(), columnCounts_.end());
+  const float deepest = float(most) * std::pow(latticeSpacing_, float(Dim)) / columnArea_;
+  return static_cast<float>(depthStableStep(latticeSpacing_, g, deepest));
 }
 
 // The carried channels one after another.

@@ -161,6 +161,10 @@ class ParticleSolver : public FluidSolver<Dim> {
   }
   // The fastest particle's speed after `dt` of gravity: the CFL conditions' |v|max.
   float fastestAfterFall(float dt);
+  // stableSubsteps's depth criterion on the deepest column as the fluid stands now, dt <= 0.9 spacing /
+  // sqrt(|g| depth) (infinity without gravity or particles): a dam break's column is deeper at the start than
+  // the pool it settles into.
+  float depthStableStepNow();
   // The end of a method's step: positions that crossed a periodic face move back in by a period; then the
   // first particle that is not finite, left the tank or ran away (firstParticleOutside), or -1.
   long endStep() {
@@ -175,8 +179,8 @@ class ParticleSolver : public FluidSolver<Dim> {
   void kickSurfaceTension(const std::vector<VecD>& at, float dt) {
     if (!tension_.active()) return;
     const PhaseTimer timer(times_.forces);
-    tension_.computeAccelerations(at, neighbors_, colliders_, dt);
-    tension_.kick(v_, dt);
+    tension_.computeAccelerations(at, neighbors_, colliders_, dt, fluid_);
+    tension_.kick(v_, dt, massRatio_);
   }
 
   // The fluid's viscosity (sim/viscosity.h) on v_ at `at` with the current neighbour lists, over a step dt
@@ -224,6 +228,17 @@ class ParticleSolver : public FluidSolver<Dim> {
     forEachCarriedChannel(visit);
     viscosity_.forEachCarriedChannel(visit);
   }
+
+  // The deepest column (depthStableStepNow): the particles counted on a grid over the tank's floor, its cells
+  // kColumnSpacings spacings across; a column's depth is its particles' volume over its cell's area (a pool's
+  // depth in a pool, a thin jet's little).
+  static constexpr float kColumnSpacings = 4;
+  float latticeSpacing_ = 0;
+  int down_ = 1;                      // the axis gravity is mostly along
+  Vec<Dim> floorMin_, columnWidth_;   // the grid's corner and cell size (the down axis's unused)
+  float columnArea_ = 1;              // a cell's area across the down axis (its length in 2D)
+  Eigen::Matrix<int, Dim, 1> columns_;
+  std::vector<uint32_t> columnCounts_;
 
   std::vector<std::vector<float>> carriedHold_;  // editParticles: the carried channels while the rest resize
   float sceneSpeedLimit_;  // runawaySpeed(scene)

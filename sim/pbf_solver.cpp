@@ -13,8 +13,6 @@
 namespace surge {
 namespace {
 
-constexpr float kColumnSpacings = 4;  // the deepest-column grid's cells, in spacings across
-
 // x^n for an integer 1 <= n <= 16 by squaring (std::pow costs more than the rest of the pair), with no branch
 // on x, so that it vectorises.
 inline float integerPower(float x, int n) {
@@ -73,18 +71,7 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
   iterations_ = s.iterations;
   maxDensityError_ = s.max_density_error;
   cfl_ = static_cast<float>(s.cfl);
-  spacing_ = spacing;
   frameStep_ = static_cast<float>(1.0 / (scene.output.fps * std::max(1, substeps_)));
-  this->gravity_.cwiseAbs().maxCoeff(&down_);
-  floorMin_ = toVec<Dim>(scene.domain.min);
-  columns_.setOnes();
-  columnWidth_ = toVec<Dim>(scene.domain.max - scene.domain.min);
-  for (int k = 0; k < Dim; ++k) {
-    if (k == down_) continue;
-    columns_[k] = std::max(1, int(std::lround(columnWidth_[k] / (kColumnSpacings * spacing))));
-    columnWidth_[k] /= float(columns_[k]);
-    columnArea_ *= columnWidth_[k];
-  }
 }
 
 // The CFL condition on the fastest particle after a step's gravity, dt <= cfl kernel_radius / |v|max, and the
@@ -93,29 +80,8 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
 template <int Dim>
 float PbfSolver<Dim>::stableTimeStep() {
   const float fastest = this->fastestAfterFall(frameStep_);
-  float dt = fastest > 0 ? cfl_ * kernels_.radius() / fastest : INFINITY;
-  const float g = this->gravity_.norm();
-  if (g > 0 && size() > 0)
-    dt = std::min(dt, static_cast<float>(depthStableStep(spacing_, g, deepestColumn())));
+  const float dt = std::min(fastest > 0 ? cfl_ * kernels_.radius() / fastest : INFINITY, this->depthStableStepNow());
   return std::min({dt, this->tension_.stableStep(), this->viscosity_.stableStep()});
-}
-
-// A column's depth is the volume of its particles over its cell's area: a pool's depth in a pool, a thin jet's
-// little. Counting is a pass over the particles in order, the same at any thread count.
-template <int Dim>
-float PbfSolver<Dim>::deepestColumn() {
-  columnCounts_.assign(size_t(columns_.prod()), 0);
-  for (const VecD& p : x_) {
-    size_t cell = 0;
-    for (int k = Dim - 1; k >= 0; --k) {
-      if (k == down_) continue;
-      const int c = std::clamp(int((p[k] - floorMin_[k]) / columnWidth_[k]), 0, columns_[k] - 1);
-      cell = cell * size_t(columns_[k]) + size_t(c);
-    }
-    ++columnCounts_[cell];
-  }
-  const uint32_t most = *std::max_element(columnCounts_.begin(), columnCounts_.end());
-  return float(most) * std::pow(spacing_, float(Dim)) / columnArea_;
 }
 
 template <int Dim>

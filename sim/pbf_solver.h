@@ -109,14 +109,7 @@ class PbfSolver final : public ParticleSolver<Dim> {
   int iterations_;
   double maxDensityError_;
   int substeps_;
-  float cfl_, frameStep_, spacing_;  // the Courant number; a frame over the substeps; the particle spacing
-  // The deepest column (stableTimeStep): the particles counted on a grid over the tank's floor.
-  float deepestColumn();
-  int down_ = 1;                      // the axis gravity is mostly along
-  Vec<Dim> floorMin_, columnWidth_;   // the grid's corner and cell size (the down axis's unused)
-  float columnArea_ = 1;              // a cell's area across the down axis (its length in 2D)
-  Eigen::Matrix<int, Dim, 1> columns_;
-  std::vector<uint32_t> columnCounts_;
+  float cfl_, frameStep_;  // the Courant number; a frame over the substeps
 
   // PBF's channels beside the core's: the predicted positions x* and the multipliers.
   std::vector<VecD> p_;

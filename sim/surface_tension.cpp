@@ -1,6 +1,7 @@
 #include "sim/surface_tension.h"
 
 #include <algorithm>
+#include <type_traits>
 #include <unordered_set>
 
 #include "core/parallel.h"
@@ -46,7 +47,9 @@ double adhesionKernel(int dim, double r, double h) {
 }  // namespace
 
 double sceneSurfaceTension(const Scene& scene) {
-  return scene.fluids.empty() ? 0.0 : scene.fluids.front().surface_tension;
+  double most = 0;
+  for (const auto& fluid : scene.fluids) most = std::max(most, fluid.surface_tension);
+  return most;
 }
 
 bool sceneHasAdhesion(const Scene& scene) {
@@ -58,8 +61,7 @@ bool sceneHasAdhesion(const Scene& scene) {
 }
 
 double surfaceEnergyBound(const Scene& scene, const ParticleFrame& initial) {
-  const double sigma = sceneSurfaceTension(scene);
-  if (sigma <= 0) return 0;
+  if (sceneSurfaceTension(scene) <= 0) return 0;
   if (!scene.emitters.empty()) return INFINITY;
   const double spacing = scene.particle_spacing;
   const int dim = scene.dimensions;
@@ -72,19 +74,29 @@ double surfaceEnergyBound(const Scene& scene, const ParticleFrame& initial) {
     return (uint64_t(uint32_t(c[0]) & 0x1fffff) << 42) | (uint64_t(uint32_t(c[1]) & 0x1fffff) << 21) |
            uint64_t(uint32_t(c[2]) & 0x1fffff);
   };
-  std::unordered_set<uint64_t> cells;
-  for (const Eigen::Vector3f& p : initial.position) cells.insert(key(cell(p)));
-  size_t faces = 0;
-  for (const Eigen::Vector3f& p : initial.position) {
-    const Eigen::Vector3i c = cell(p);
-    for (int k = 0; k < dim; ++k)
-      for (int side : {-1, 1}) {
-        Eigen::Vector3i beside = c;
-        beside[k] += side;
-        faces += cells.count(key(beside)) == 0;
-      }
+  // Each fluid's faces against cells not of that fluid (air, or another fluid: each sees the others as air).
+  const auto fluidOf = [&](size_t i) { return initial.fluid.empty() ? size_t(0) : size_t(initial.fluid[i]); };
+  double energy = 0;
+  for (size_t f = 0; f < scene.fluids.size(); ++f) {
+    const double sigma = scene.fluids[f].surface_tension;
+    if (sigma <= 0 || (f > 0 && initial.fluid.empty())) continue;
+    std::unordered_set<uint64_t> cells;
+    for (size_t i = 0; i < initial.size(); ++i)
+      if (fluidOf(i) == f) cells.insert(key(cell(initial.position[i])));
+    size_t faces = 0;
+    for (size_t i = 0; i < initial.size(); ++i) {
+      if (fluidOf(i) != f) continue;
+      const Eigen::Vector3i c = cell(initial.position[i]);
+      for (int k = 0; k < dim; ++k)
+        for (int side : {-1, 1}) {
+          Eigen::Vector3i beside = c;
+          beside[k] += side;
+          faces += cells.count(key(beside)) == 0;
+        }
+    }
+    energy += sigma * double(faces) * std::pow(spacing, dim - 1);
   }
-  return sigma * double(faces) * std::pow(spacing, dim - 1);
+  return energy;
 }
 
 template <int Dim>
@@ -102,6 +114,20 @@ SurfaceTension<Dim>::SurfaceTension(const Scene& scene, float mass) {
   cohesionScale_ = cohesionNormalisation(Dim, support_);
   gamma_ = static_cast<float>(sigma / tensionPerGamma(spacing, support_, mass));
   stableStep_ = static_cast<float>(std::sqrt(scene.solver.rest_density * std::pow(spacing, 3) / (2 * M_PI * sigma)));
+  // Each fluid's own gamma and particle mass (ParticleSolver's mass ratios); one fluid keeps the above.
+  const bool several = scene.severalFluids();
+  std::vector<double> density, ratio;
+  for (size_t f = 0; f < (several ? scene.fluids.size() : 1); ++f) {
+    const double sigmaF = several ? scene.fluids[f].surface_tension : sigma;
+    density.push_back(several ? scene.fluids[f].rest_density : scene.solver.rest_density);
+    const float m = several ? mass * static_cast<float>(scene.fluids[f].rest_density / scene.referenceDensity()) : mass;
+    fluidMass_.push_back(m);
+    fluidGamma_.push_back(several ? (sigmaF > 0 ? static_cast<float>(sigmaF / tensionPerGamma(spacing, support_, m)) : 0.0f)
+                                  : gamma_);
+    if (several && sigmaF > 0)
+      stableStep_ = std::min(stableStep_, static_cast<float>(std::sqrt(density.back() * std::pow(spacing, 3) /
+                                                                       (2 * M_PI * sigmaF))));
+  }
 
   // Adhesion: the flat wall's sum of V A along its normal, tabulated by distance, and each solid's beta.
   std::vector<double> adhesion;
@@ -125,8 +151,16 @@ SurfaceTension<Dim>::SurfaceTension(const Scene& scene, float mass) {
         pull);
     adhesionTable_[t] = static_cast<float>(pull[0]);
   }
+  // beta from a = W_a / (2 sigma); a fluid's work per beta scales with its m rho_0 (adhesionWorkPerBeta).
   const double workPerBeta = adhesionWorkPerBeta();
-  for (double a : adhesion) beta_.push_back(static_cast<float>(a * 2 * sigma / workPerBeta));
+  for (size_t f = 0; f < fluidMass_.size(); ++f) {
+    const double sigmaF = several ? scene.fluids[f].surface_tension : sigma;
+    const double work = several ? workPerBeta * (double(fluidMass_[f]) * density[f]) / (double(mass_) * restDensity_)
+                                : workPerBeta;
+    const float rho = several ? static_cast<float>(density[f]) : restDensity_;
+    pull_.emplace_back();
+    for (double a : adhesion) pull_.back().push_back(static_cast<float>(a * 2 * sigmaF / work) * rho);
+  }
 }
 
 template <int Dim>
@@ -195,12 +229,16 @@ double SurfaceTension<Dim>::tensionPerGamma(float spacing, float support, float 
 
 template <int Dim>
 void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const NeighborLists& neighbors,
-                                               Colliders<Dim>& colliders, float impulseScale) {
+                                               Colliders<Dim>& colliders, float impulseScale,
+                                               const std::vector<uint8_t>& fluid) {
   const size_t n = x.size();
   accel_.resize(n);
   colour_.resize(n);
   normal_.resize(n);
   const float self = volume_ * kernel_.value(0);
+  // One fluid compiles without the fluid checks (its loops as they were before several fluids).
+  const auto passes = [&](auto severalFluids) {
+  constexpr bool several = decltype(severalFluids)::value;
   periodic_.withNearestImage([&](const auto& sharedWrap) {
   parallelFor(0, n, [&](size_t b, size_t e) {
     const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
@@ -208,6 +246,7 @@ void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const
       float c = self;
       VecD normal = VecD::Zero();
       for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
+        if (several && fluid[*j] != fluid[i]) continue;  // another fluid counts as air
         VecD r = x[i] - x[*j];
         wrap(r);
         const SphKernelPair k = kernel_.pair(r.norm());
@@ -222,36 +261,46 @@ void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const
   parallelFor(0, n, [&](size_t b, size_t e) {
     const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     for (size_t i = b; i < e; ++i) {
+      const size_t f = several ? fluid[i] : 0;
+      const float m = fluidMass_[f];
       VecD a = VecD::Zero();
       for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
+        if (several && fluid[*j] != f) continue;
         VecD r = x[i] - x[*j];
         wrap(r);
         const float length = r.norm();
         VecD pair = normal_[*j] - normal_[i];  // eq. 4
-        if (length > tiny) pair -= (mass_ * cohesion(length) / length) * r;  // eq. 1
+        if (length > tiny) pair -= (m * cohesion(length) / length) * r;  // eq. 1
         a += (2.0f / (colour_[i] + colour_[*j])) * pair;  // eq. 6's K_ij
       }
-      a *= gamma_;
+      a *= fluidGamma_[f];
       if (adhesive_)
         colliders.forEachNear(x[i], [&](size_t c, float d, const VecD& wallNormal) {
-          if (beta_[c] <= 0) return;
-          const VecD pull = (-beta_[c] * restDensity_ * wallAdhesion(d)) * wallNormal;  // eq. 7, to the wall
+          if (pull_[f][c] <= 0) return;
+          const VecD pull = (-pull_[f][c] * wallAdhesion(d)) * wallNormal;  // eq. 7, to the wall
           a += pull;
-          colliders.addImpulse(i, c, (mass_ * impulseScale) * pull, x[i]);
+          colliders.addImpulse(i, c, (m * impulseScale) * pull, x[i]);
         });
       accel_[i] = a;
     }
   });
   });
+  };
+  if (fluid.empty())
+    passes(std::false_type{});
+  else
+    passes(std::true_type{});
 }
 
 template <int Dim>
-void SurfaceTension<Dim>::kick(std::vector<VecD>& v, float dt) {
+void SurfaceTension<Dim>::kick(std::vector<VecD>& v, float dt, const std::vector<float>& massRatio) {
+  const bool several = !massRatio.empty();
   work_ += parallelSum<double>(0, v.size(), [&](size_t b, size_t e) {
     double work = 0;
     for (size_t i = b; i < e; ++i) {
       const VecD dv = dt * accel_[i];
-      work += double(accel_[i].dot(v[i] + 0.5f * dv));
+      const double w = double(accel_[i].dot(v[i] + 0.5f * dv));
+      work += several ? w * massRatio[i] : w;
       v[i] += dv;
     }
     return work;
@@ -266,10 +315,11 @@ void SurfaceTension<Dim>::addTo(std::vector<VecD>& a) const {
 }
 
 template <int Dim>
-void SurfaceTension<Dim>::addWork(const std::vector<VecD>& v, float dt) {
+void SurfaceTension<Dim>::addWork(const std::vector<VecD>& v, float dt, const std::vector<float>& massRatio) {
+  const bool several = !massRatio.empty();
   work_ += parallelSum<double>(0, v.size(), [&](size_t b, size_t e) {
     double work = 0;
-    for (size_t i = b; i < e; ++i) work += double(accel_[i].dot(v[i]));
+    for (size_t i = b; i < e; ++i) work += several ? double(accel_[i].dot(v[i])) * massRatio[i] : double(accel_[i].dot(v[i]));
     return work;
   }) * double(mass_) * dt;
 }

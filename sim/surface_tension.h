@@ -12,6 +12,9 @@
 // gamma is set from sigma (N/m) by Kirkwood and Buff's formula on the rest lattice (tensionPerGamma): the
 // tension of a flat slab of the lattice per unit gamma; beta from `adhesion` a = W_a / (2 sigma), the work of
 // adhesion against the fluid's work of cohesion, by the same sums (Young: cos theta = 2 a - 1).
+// Several fluids: each fluid's particles pull together with its own gamma (from its sigma and its particles'
+// mass), and their colour and normals count the same fluid's neighbours only, so each fluid sees another as it
+// sees air and their interface holds sigma_1 + sigma_2; adhesion pulls each fluid by its own sigma.
 // docs/surface-tension.md has the derivation and what it measures. Every loop gathers: the same bytes at any
 // thread count. A scene without surface tension or adhesion holds no channel and runs no pass.
 #pragma once
@@ -27,7 +30,7 @@
 
 namespace surge {
 
-// Sigma of the scene's fluid (fluids[i].surface_tension, one value for all of them), 0 without.
+// The largest sigma of the scene's fluids (fluids[i].surface_tension), 0 without.
 double sceneSurfaceTension(const Scene& scene);
 // True if some collider or body has adhesion.
 bool sceneHasAdhesion(const Scene& scene);
@@ -54,14 +57,15 @@ class SurfaceTension {
 
   // The accelerations at positions x (neighbour lists of radius h, in x's order), kept for the calls below.
   // `colliders`: for the adhesion; its impulses are recorded as m a `impulseScale` (dt for a velocity change,
-  // 1 for a force the caller integrates).
+  // 1 for a force the caller integrates). `fluid`: each particle's fluid block (empty: one fluid).
   void computeAccelerations(const std::vector<VecD>& x, const NeighborLists& neighbors, Colliders<Dim>& colliders,
-                            float impulseScale);
-  // v_i += dt a_i, counting the work sum m a . (v + dt a / 2) dt.
-  void kick(std::vector<VecD>& v, float dt);
+                            float impulseScale, const std::vector<uint8_t>& fluid);
+  // v_i += dt a_i, counting the work sum m a . (v + dt a / 2) dt; `massRatio`: each particle's mass over the
+  // method's (empty: one fluid).
+  void kick(std::vector<VecD>& v, float dt, const std::vector<float>& massRatio);
   // a_i += the accelerations (WCSPH), and the work over a step dt at velocities v (addWork).
   void addTo(std::vector<VecD>& a) const;
-  void addWork(const std::vector<VecD>& v, float dt);
+  void addWork(const std::vector<VecD>& v, float dt, const std::vector<float>& massRatio);
   // The work the forces did on the fluid since the last call (J; J/m in 2D): the surface energy they release.
   double takeWork() {
     const double w = work_;
@@ -86,7 +90,10 @@ class SurfaceTension {
   float gamma_ = 0, mass_ = 0, volume_ = 0, spacing_ = 0, support_ = 0, restDensity_ = 0, stableStep_ = INFINITY;
   float cohesionScale_ = 0;
   bool adhesive_ = false;
-  std::vector<float> beta_;        // per collider (bodies after the colliders): eq. 7's beta, 0 none
+  // By fluid block (one entry for one fluid): gamma, the particles' mass, and per collider (bodies after the
+  // colliders) eq. 7's beta rho_0, 0 none.
+  std::vector<float> fluidGamma_, fluidMass_;
+  std::vector<std::vector<float>> pull_;
   std::vector<float> adhesionTable_;
   float adhesionScale_ = 0;        // table entries per metre
   std::vector<float> colour_;

@@ -90,7 +90,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     parallelFor(0, size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) v_[i] += (0.5f * dt) * a_[i];
     });
-    if (this->tension_.active()) this->tension_.addWork(v_, dt);  // at the half step's velocities
+    if (this->tension_.active()) this->tension_.addWork(v_, dt, this->massRatio_);  // at the half step's velocities
     if (colliding) colliders_.addWrenches(colliderForces_, 0.5 * dt);
     driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_);
     if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
@@ -105,7 +105,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     parallelFor(0, size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) v_[i] += dt * a_[i];
     });
-    if (this->tension_.active()) this->tension_.addWork(v_, dt);
+    if (this->tension_.active()) this->tension_.addWork(v_, dt, this->massRatio_);
     if (colliding) colliders_.addWrenches(colliderForces_, dt);
     driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_);
     if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
@@ -240,7 +240,7 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
   });
   // Surface tension and adhesion (sim/surface_tension.h), their adhesion recorded as forces with the others.
   if (this->tension_.active()) {
-    this->tension_.computeAccelerations(x_, neighbors_, colliders_, 1.0f);
+    this->tension_.computeAccelerations(x_, neighbors_, colliders_, 1.0f, this->fluid_);
     this->tension_.addTo(a_);
   }
   if (!colliders_.empty()) colliderForces_ = colliders_.takeSlotSums();

@@ -207,6 +207,58 @@ TEST(SurfaceTension, SameBytesAtAnyThreadCountAndAfterAResume) {
   }
 }
 
+// Several fluids: each pulls together with its own sigma and sees the other as air, so their interface holds
+// sigma_1 + sigma_2 (sim/surface_tension.h). A 2:1 rectangle of oil (rho 900, sigma 0.03, 30 x 15 particles)
+// inside water (sigma 0.0728) in zero gravity starts at anisotropy 0.60 and rounds in every method. Measured at
+// 1 s: DFSPH 0.47, PBF 0.08, WCSPH 0.53; DFSPH and WCSPH stop short of round as one fluid's 2D rectangle does
+// (0.62 and 0.57, the lattice's set, docs/surface-tension.md), so the bound is only that the interface pulls:
+// under 0.56, two thirds of WCSPH's fall. Without the sigmas the rectangle keeps 0.601 to 1e-3. In DFSPH the run
+// is the same bytes at 1 and 2 threads and after a resume.
+Scene oilInWater(const std::string& method, bool tension) {
+  const std::string water = tension ? ", \"surface_tension\": 0.0728" : "";
+  const std::string oil = tension ? ", \"surface_tension\": 0.03" : "";
+  return parseScene(
+      R"({"name": "oil_in_water", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.06, 0.06]},
+          "particle_spacing": 0.001, "gravity": [0, 0], "solver": {"method": ")" + method + R"("},
+          "output": {"fps": 20, "frames": 20}, "fluids": [
+            {"name": "water", "box": {"min": [0, 0], "max": [0.06, 0.0225]})" + water + R"(},
+            {"name": "water", "box": {"min": [0, 0.0375], "max": [0.06, 0.06]})" + water + R"(},
+            {"name": "water", "box": {"min": [0, 0.0225], "max": [0.015, 0.0375]})" + water + R"(},
+            {"name": "water", "box": {"min": [0.045, 0.0225], "max": [0.06, 0.0375]})" + water + R"(},
+            {"name": "oil", "rest_density": 900, "box": {"min": [0.015, 0.0225], "max": [0.045, 0.0375]})" + oil +
+          "}]}",
+      "oil_in_water.json");
+}
+
+double oilAnisotropy(const fs::path& dir, int frame) {
+  const ParticleFrame f = readParticlePly(framePath(dir, "particles", frame, "ply"));
+  std::vector<Vec<2>> oil;
+  for (size_t i = 0; i < f.size(); ++i)
+    if (f.fluid.at(i) == 4) oil.push_back(f.position[i].head<2>());
+  EXPECT_EQ(oil.size(), 450u);
+  return anisotropy<2>(oil);
+}
+
+TEST(SurfaceTension, AnOilRectangleInWaterRoundsInEveryMethod) {
+  for (const std::string method : {"dfsph", "pbf", "wcsph"}) {
+    const fs::path dir = runScene(oilInWater(method, true), "oil_in_water_" + method);
+    const double start = oilAnisotropy(dir, 0), end = oilAnisotropy(dir, 20);
+    std::printf("%s: oil's anisotropy %.3f at 0 s, %.3f at 1 s\n", method.c_str(), start, end);
+    EXPECT_NEAR(start, 0.60, 0.01) << method;
+    EXPECT_LT(end, 0.56) << method;
+  }
+  EXPECT_NEAR(oilAnisotropy(runScene(oilInWater("dfsph", false), "oil_in_water_still"), 20), 0.601, 1e-3);
+  Scene scene = oilInWater("dfsph", true);
+  scene.output.frames = 6;
+  const auto lastFrame = [](const fs::path& dir) { return readTextFile(framePath(dir, "particles", 6, "ply")); };
+  const std::string two = lastFrame(runScene(scene, "oil_two", 2));
+  EXPECT_EQ(lastFrame(runScene(scene, "oil_one", 1)), two);
+  Scene half = scene;
+  half.output.frames = 3;
+  runScene(half, "oil_resumed", 2);
+  EXPECT_EQ(lastFrame(runScene(scene, "oil_resumed", 1, true)), two);
+}
+
 // Adhesion a = W_adhesion / (2 sigma) (sim/surface_tension.h): a cube of water (12^3 particles) set on a plate in
 // zero gravity settles to Young's angle, cos theta = 2a - 1, read from the spherical cap's height h and contact
 // radius r as theta = 2 atan(h / r). Half a spacing on each of h and r (about 9 spacings) moves that angle by up

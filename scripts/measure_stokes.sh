@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# The runs behind docs/viscosity.md's "Solids moving through a viscous fluid": a ball settling through a viscous
+# fluid (Stokes), a sphere and a disc moved through it at a set speed (their drag), and a disc spinning in it (its
+# torque), each printed beside the value it is measured against. Not a test: Surge does not meet these yet.
+# About 5 minutes on two cores (the 3D runs).
+#
+#   scripts/measure_stokes.sh [SURGE_BINARY]
+set -euo pipefail
+surge=${1:-build/apps/surge}
+work=out/measure_stokes
+mkdir -p "$work"
+
+run() {  # run NAME JSON [--set ...]: simulates JSON into $work/NAME
+  local name=$1 json=$2
+  shift 2
+  printf '%s\n' "$json" > "$work/$name.json"
+  "$surge" sim "$work/$name.json" --out "$work/$name" --quiet "$@"
+}
+# column COLUMN FILE: a CSV column by its header name, one value a line (the header dropped).
+column() { awk -F, -v want="$1" 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == want) c = i; next } { print $c }' "$2"; }
+
+# 3D: a ball of radius a = 0.05 (4 spacings) in a tank 0.5 x 0.6 x 0.5 full of fluid; the wall factor for a
+# sphere on the axis of a square duct of half-width l = 0.25 is about 1 - 1.903 a / l = 0.62.
+tank3='"dimensions": 3, "domain": {"min": [0, 0, 0], "max": [0.5, 0.6, 0.5]}, "particle_spacing": 0.0125,
+  "gravity": [0, -9.81, 0], "solver": {"method": "dfsph"}'
+fluid3() { echo "\"fluids\": [{\"box\": {\"min\": [0, 0, 0], \"max\": [0.5, 0.6, 0.5]}, \"viscosity\": $1}]"; }
+
+run steel "{\"name\": \"steel\", $tank3, $(fluid3 0.37), \"output\": {\"fps\": 40, \"frames\": 40},
+  \"bodies\": [{\"name\": \"ball\", \"shape\": \"sphere\", \"position\": [0.25, 0.35, 0.25], \"radius\": 0.05,
+                \"density\": 7800}]}"
+awk -F, '$2 == "ball" && ($1 == 20 || $1 == 40) { y[$1] = $4; f[$1] = $17 }
+  END { u = (y[20] - y[40]) / 0.5; stokes = 2 * 6800 * 9.81 * 0.05 ^ 2 / (9 * 1000 * 0.37);
+        printf "steel ball (7800, nu 0.37): settles at %.4f m/s, Stokes %.4f, with the wall factor about %.4f; fluid force %.1f N against its weight %.2f N\n",
+               u, stokes, 0.62 * stokes, f[40], 7800 * 4 / 3 * 3.14159265 * 0.05 ^ 3 * 9.81 }' "$work/steel/bodies.csv"
+
+run moved "{\"name\": \"moved\", $tank3, $(fluid3 0.37), \"output\": {\"fps\": 40, \"frames\": 16},
+  \"colliders\": [{\"name\": \"ball\", \"shape\": \"sphere\", \"position\": [0.25, 0.35, 0.25], \"radius\": 0.05,
+    \"motion\": [{\"time\": 0, \"position\": [0.25, 0.35, 0.25]}, {\"time\": 1, \"position\": [0.25, 0.25, 0.25]}]}]}"
+column fy "$work/moved/colliders.csv" | tail -8 | awk '{ s += $1 } END {
+  buoyancy = 1000 * 4 / 3 * 3.14159265 * 0.05 ^ 3 * 9.81; stokes = 6 * 3.14159265 * 370 * 0.05 * 0.1;
+  printf "sphere moved at 0.1 m/s: drag %.1f N (force %.1f less buoyancy %.2f), Stokes %.1f N, with the wall factor about %.0f\n",
+         s / NR - buoyancy, s / NR, buoyancy, stokes, stokes / 0.62 }'
+
+run light "{\"name\": \"light\", $tank3, $(fluid3 0.136), \"output\": {\"fps\": 40, \"frames\": 12},
+  \"bodies\": [{\"name\": \"ball\", \"shape\": \"sphere\", \"position\": [0.25, 0.35, 0.25], \"radius\": 0.05,
+                \"density\": 1500}]}"
+awk -F, '$2 == "ball" { if ($11 < lo) lo = $11; if ($11 > hi) hi = $11 }
+  END { printf "light ball (1500, nu 0.136): vertical velocity between %.3f and %.3f m/s over 12 frames, Stokes with the wall factor about %.4f\n",
+               lo, hi, 0.62 * 2 * 500 * 9.81 * 0.05 ^ 2 / (9 * 136) }' "$work/light/bodies.csv"
+
+# 2D: a disc of radius 0.05 moved at 0.1 m/s along the middle of a channel 0.5 wide and 2 long (Faxen's drag for
+# a cylinder midway between two walls), and the same disc spinning at pi/2 rad/s in a 0.5 m box (circular
+# Couette's torque, the box taken as a cylinder of radius 0.25).
+faxen=$(awk 'BEGIN { l = 0.25; a = 0.05; r = a / l;
+  printf "%.1f", 4 * 3.14159265 * 370 * 0.1 / (log(l / a) - 0.9157 + 1.7244 * r ^ 2 - 1.7302 * r ^ 4) }')
+for method in dfsph pbf wcsph; do
+  for spacing in 0.0125 0.00625; do
+    [[ $method != dfsph && $spacing != 0.0125 ]] && continue
+    run "disc_${method}_$spacing" "{\"name\": \"disc\", \"dimensions\": 2, \"domain\": {\"min\": [0, 0], \"max\": [0.5, 2.0]},
+      \"particle_spacing\": $spacing, \"gravity\": [0, 0], \"solver\": {\"method\": \"$method\"},
+      \"fluids\": [{\"box\": {\"min\": [0, 0], \"max\": [0.5, 2.0]}, \"viscosity\": 0.37}], \"output\": {\"fps\": 40, \"frames\": 16},
+      \"colliders\": [{\"name\": \"disc\", \"shape\": \"sphere\", \"position\": [0.25, 1.0], \"radius\": 0.05,
+        \"motion\": [{\"time\": 0, \"position\": [0.25, 1.0]}, {\"time\": 1, \"position\": [0.25, 0.9]}]}]}"
+    column fy "$work/disc_${method}_$spacing/colliders.csv" | tail -3 |
+      awk -v m="$method" -v s="$spacing" -v f="$faxen" '{ t += $1 } END {
+        printf "disc moved at 0.1 m/s, %s, spacing %s: drag %.0f N/m, Faxen %s\n", m, s, t / NR, f }'
+  done
+  run "spin_$method" "{\"name\": \"spin\", \"dimensions\": 2, \"domain\": {\"min\": [0, 0], \"max\": [0.5, 0.5]},
+    \"particle_spacing\": 0.0125, \"gravity\": [0, 0], \"solver\": {\"method\": \"$method\"},
+    \"fluids\": [{\"box\": {\"min\": [0, 0], \"max\": [0.5, 0.5]}, \"viscosity\": 0.37}], \"output\": {\"fps\": 40, \"frames\": 12},
+    \"colliders\": [{\"name\": \"disc\", \"shape\": \"sphere\", \"position\": [0.25, 0.25], \"radius\": 0.05,
+      \"motion\": [{\"time\": 0, \"position\": [0.25, 0.25]},
+                 {\"time\": 1, \"position\": [0.25, 0.25], \"rotation\": {\"degrees\": 90}}]}]}"
+  column tz "$work/spin_$method/colliders.csv" | tail -2 | awk -v m="$method" '{ t += $1 } END {
+    a = 0.05; b = 0.25; exact = 4 * 3.14159265 * 370 * 1.5707963 * a ^ 2 * b ^ 2 / (b ^ 2 - a ^ 2);
+    printf "disc spinning at pi/2 rad/s, %s: torque %.2f N m/m, circular Couette %.2f\n", m, -t / NR, exact }'
+done
