@@ -62,6 +62,24 @@ void Colliders<Dim>::setBodyPose(size_t body, const Pose& pose, const Eigen::Vec
 }
 
 template <int Dim>
+void Colliders<Dim>::placeAtStepStart(double time, float dt) {
+  // A body's start pose S and end pose E: placed at S, its step-start pose taken as S E^-1 S (the coming step's
+  // motion run backwards from S), so that its walls move at the coming step's velocity.
+  const std::vector<Pose> start = bodyStart_, end = bodyEnd_;
+  for (size_t b = 0; b < start.size(); ++b) {
+    const Pose& s = start[b];
+    const Eigen::Quaterniond back = s.rotation * end[b].rotation.conjugate();
+    bodyEnd_[b] = s;
+    bodyStart_[b].rotation = (back * s.rotation).normalized();
+    bodyStart_[b].translation = back * (s.translation - end[b].translation) + s.translation;
+    bodyStart_[b].scale = s.scale;
+  }
+  beginStep(time - dt, dt);
+  bodyStart_ = start;
+  bodyEnd_ = end;
+}
+
+template <int Dim>
 std::vector<Wrench> Colliders<Dim>::takeStepWrenches(double dt) {
   addWrenches(takeSlotSums(), 1.0);
   std::vector<Wrench> step(extra_.size());

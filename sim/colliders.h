@@ -73,6 +73,10 @@ class Colliders {
   // Places the colliders for a step from `time` to `time + dt`, at its end; each wall's velocity is its motion
   // over the step.
   void beginStep(double time, float dt);
+  // Places every solid where it stands at `time`, the start of a step of dt: a keyframed collider moving as over
+  // [time - dt, time], a body at its pose before the last setBodyPose, moving as over the coming step. From
+  // (time, dt) and the bodies' poses alone: a run resumed from a frame places them as the uninterrupted run.
+  void placeAtStepStart(double time, float dt);
 
   // Bodies: solid firstBody() + b is body b. setBodyPose gives body b's pose at the end of the coming step (its
   // pose at the step's start is the one given before) and its centre of mass there, about which its torque is

@@ -63,14 +63,13 @@ float DfsphSolver<Dim>::stableTimeStep() {
 
 template <int Dim>
 long DfsphSolver<Dim>::step(float dt, double time) {
-  // Keyframed colliders are placed as a step of this dt ending now leaves them (their pose now, their velocity
-  // over [time - dt, time]), from (time, dt) alone: the uninterrupted run and one resumed from a frame (whose
-  // colliders knew no step before) read the same walls in this step's forces and density solve. A scene with
-  // bodies keeps the last step's placement (their poses come per step from the coupling).
-  const bool keyframed = colliders_.anyMoving() && colliders_.firstBody() == colliders_.size();
-  if (keyframed) colliders_.beginStep(time - dt, dt);
+  // The moving solids are placed where they stand now (Colliders::placeAtStepStart), from (time, dt) and the
+  // bodies' poses alone: the uninterrupted run and one resumed from a frame (whose colliders knew no step
+  // before) read the same walls in this step's forces and density solve.
+  const bool moving = colliders_.anyMoving();
+  if (moving) colliders_.placeAtStepStart(time, dt);
   if (!prepared_) prepareStep();
-  else if (keyframed) updateWallFlux();
+  else if (moving) updateWallFlux();
   applyNonPressureForces(dt, time);
 
   // Algorithm 3: the density solver on v*, then the move.

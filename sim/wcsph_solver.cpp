@@ -18,6 +18,7 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const Collider
   const SolverSettings& s = scene.solver;
   support_ = static_cast<float>(s.kernel_radius);
   smoothingLength_ = 0.5f * support_;
+  frameDuration_ = static_cast<float>(1.0 / scene.output.fps);
   speedOfSound_ = static_cast<float>(s.speed_of_sound);
   gasConstant_ = static_cast<float>(s.gas_constant);
   taitB_ = restDensity_ * speedOfSound_ * speedOfSound_ / 7.0f;
@@ -44,6 +45,7 @@ template <int Dim>
 void WcsphSolver<Dim>::beginFrame(double time) {
   time_ = time;
   accelerationsValid_ = false;
+  frameStart_ = true;
   framePressureMax_ = 0;
 }
 
@@ -54,8 +56,11 @@ template <int Dim>
 float WcsphSolver<Dim>::stableTimeStep() {
   if (fixedStep_ > 0) return fixedStep_;
   if (!accelerationsValid_) {
+    // At a frame's start the solids are placed where they stand (a resumed run's colliders knew no step before).
+    if (frameStart_ && colliders_.anyMoving()) colliders_.placeAtStepStart(time_, frameDuration_);
     computeAccelerations(time_);  // the state's time: step() then uses these accelerations as a(x_n)
   }
+  frameStart_ = false;
   struct Maxima {
     float speed = 0, acceleration = 0;
     Maxima& operator+=(const Maxima& o) {

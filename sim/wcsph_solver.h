@@ -77,6 +77,8 @@ class WcsphSolver final : public ParticleSolver<Dim> {
   std::vector<Wrench> colliderForces_;   // each collider's force at the last evaluation (for the impulses)
 
   bool accelerationsValid_ = false;
+  bool frameStart_ = true;      // beginFrame: the next accelerations place the moving solids first
+  float frameDuration_ = 0;     // 1 / fps: a keyframed solid's velocity at a frame's start is over the frame before
   double time_ = 0;  // the simulated time of the current state (moves the attractor)
   float framePressureMax_ = 0;
 };
