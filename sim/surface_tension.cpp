@@ -116,9 +116,10 @@ SurfaceTension<Dim>::SurfaceTension(const Scene& scene, float mass) {
   stableStep_ = static_cast<float>(std::sqrt(scene.solver.rest_density * std::pow(spacing, 3) / (2 * M_PI * sigma)));
   // Each fluid's own gamma and particle mass (ParticleSolver's mass ratios); one fluid keeps the above.
   const bool several = scene.severalFluids();
-  std::vector<double> density, ratio;
+  std::vector<double> fluidSigma, density;
   for (size_t f = 0; f < (several ? scene.fluids.size() : 1); ++f) {
     const double sigmaF = several ? scene.fluids[f].surface_tension : sigma;
+    fluidSigma.push_back(sigmaF);
     density.push_back(several ? scene.fluids[f].rest_density : scene.solver.rest_density);
     const float m = several ? mass * static_cast<float>(scene.fluids[f].rest_density / scene.referenceDensity()) : mass;
     fluidMass_.push_back(m);
@@ -154,12 +155,11 @@ SurfaceTension<Dim>::SurfaceTension(const Scene& scene, float mass) {
   // beta from a = W_a / (2 sigma); a fluid's work per beta scales with its m rho_0 (adhesionWorkPerBeta).
   const double workPerBeta = adhesionWorkPerBeta();
   for (size_t f = 0; f < fluidMass_.size(); ++f) {
-    const double sigmaF = several ? scene.fluids[f].surface_tension : sigma;
     const double work = several ? workPerBeta * (double(fluidMass_[f]) * density[f]) / (double(mass_) * restDensity_)
                                 : workPerBeta;
     const float rho = several ? static_cast<float>(density[f]) : restDensity_;
     pull_.emplace_back();
-    for (double a : adhesion) pull_.back().push_back(static_cast<float>(a * 2 * sigmaF / work) * rho);
+    for (double a : adhesion) pull_.back().push_back(static_cast<float>(a * 2 * fluidSigma[f] / work) * rho);
   }
 }
 
@@ -319,7 +319,10 @@ void SurfaceTension<Dim>::addWork(const std::vector<VecD>& v, float dt, const st
   const bool several = !massRatio.empty();
   work_ += parallelSum<double>(0, v.size(), [&](size_t b, size_t e) {
     double work = 0;
-    for (size_t i = b; i < e; ++i) work += several ? double(accel_[i].dot(v[i])) * massRatio[i] : double(accel_[i].dot(v[i]));
+    for (size_t i = b; i < e; ++i) {
+      const double w = double(accel_[i].dot(v[i]));
+      work += several ? w * massRatio[i] : w;
+    }
     return work;
   }) * double(mass_) * dt;
 }
