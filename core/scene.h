@@ -56,6 +56,7 @@ struct SolverSettings {
   double artificial_viscosity = 0.05;    // Monaghan's alpha; 0 turns it off
   double kinematic_viscosity = 0;        // laminar nu (m^2/s); 0 turns it off
   double near_pressure = 0;              // Clavet et al. 2005 near-pressure stiffness; 0 turns it off
+  double background_pressure = 0;        // Adami et al. 2013's transport velocity (Pa); 0 turns it off
   std::string surface_tension_model = "akinci2013";  // how fluids[i].surface_tension acts (sim/surface_tension.h)
   // How fluids[i].viscosity acts (sim/viscosity.h): "implicit", "explicit", or "default": explicit for WCSPH,
   // implicit for the others.
@@ -138,6 +139,7 @@ struct FluidBlock {
   std::string name;
   double rest_density = 0;  // kg/m^3 (kg/m^2 in 2D); 0 in the file: solver.rest_density (resolved)
   Eigen::Vector3d color = Eigen::Vector3d::Zero();  // the render's water colour; zero: render.water_color (resolved)
+  double jitter = 0;  // each particle off its lattice site by up to jitter x half the spacing per axis; 0 none
 
   bool shaped() const { return !solid.shape.empty(); }
   static ColliderSettings shapeless() {

@@ -216,6 +216,10 @@ void visitScene(Scene& s, SceneVisitor& v) {
         v.vector("color", f.color,
                  atLeast(0.001, "that fluid's colour in the render, as render.water_color (not given: that)", "", 1),
                  true);
+        v.real("jitter", f.jitter,
+               atLeast(0, "each particle starts off its lattice site by up to this fraction of half the spacing "
+                          "along each axis (a fixed pattern, by particle), still inside its own lattice cell: a "
+                          "square lattice's rows can then not snap all at once; 0: on the lattice", "", 1));
       });
   v.vector("gravity", s.gravity, info("gravitational acceleration", "m/s^2"));
   v.group("attractor", info("a point moving along keyframes that pulls (or pushes) particles near it"), [&] {

@@ -4,7 +4,9 @@
 # - viscosity: `honey` as it ships (nu = 0.05, implicit, DFSPH) beside the same scene with nu = 0, ms a step and
 #   the forces phase (stats.csv ms_viscosity: gravity, XSPH and the viscosity) a step;
 # - periodic axes: a 3D pool at rest (50 x 20 x 50 particles) periodic along x and z beside the same pool between
-#   walls, ms a step, in each method.
+#   walls, ms a step, in each method;
+# - WCSPH's transport velocity (solver.background_pressure): Taylor-Green's box (2D, 100 x 100 particles, periodic,
+#   a uniform flow, jittered) with p_b = 2e5 Pa beside p_b = 0, ms a step and the forces phase a step.
 #
 #   scripts/bench_viscosity.sh [SURGE_BINARY] [FRAMES] [POOL_FRAMES]   (defaults 30 and 10: WCSPH's pool takes
 #   about 5 s a frame)
@@ -42,3 +44,19 @@ for method in ${METHODS:-pbf dfsph wcsph}; do
     --set 'domain.periodic=["x","z"]')
   awk -v m="$method" -v a="$walled" -v b="$periodic" 'BEGIN { printf "| %s | %.3f | %.3f | %.3f |\n", m, a, b, b / a }'
 done
+
+cat >"$work/box.json" <<'JSON'
+{"name": "box", "dimensions": 2, "domain": {"min": [0, 0], "max": [1, 1], "periodic": ["x", "y"]},
+ "particle_spacing": 0.01, "gravity": [0, 0],
+ "fluids": [{"box": {"min": [0, 0], "max": [1, 1]}, "velocity": [1, 0.5], "jitter": 0.2, "viscosity": 0.01}],
+ "solver": {"method": "wcsph", "speed_of_sound": 10, "kernel": "wendland_c2", "kernel_radius": 0.035},
+ "output": {"fps": 30, "frames": 30}}
+JSON
+echo
+echo "| Taylor-Green's box, WCSPH | ms a step | forces phase, ms a step |"
+echo "|---|---|---|"
+read -r plain plainPhase < <(best "$work/box.json" --set output.frames="$pool_frames")
+read -r pushed pushedPhase < <(best "$work/box.json" --set output.frames="$pool_frames" --set solver.background_pressure=2e5)
+awk -v a="$plain" -v b="$pushed" -v pa="$plainPhase" -v pb="$pushedPhase" 'BEGIN {
+  printf "| p_b = 0 | %.3f | %.3f |\n| p_b = 2e5 Pa | %.3f | %.3f |\n| ratio | %.3f | transport velocity %.0f%% of a step |\n",
+         a, pa, b, pb, b / a, 100 * (b - a) / b }'

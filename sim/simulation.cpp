@@ -425,6 +425,16 @@ bool isDamBreak(const Scene& scene) {
   return onFloor && atMin != atMax;
 }
 
+// A fixed number in [-0.5, 0.5) for particle `id` and axis `k` (SplitMix64's finaliser): the same for a particle
+// whatever the thread count or the run, so that a jittered start (fluids[i].jitter) is reproducible.
+static double latticeJitter(uint32_t id, int k) {
+  uint64_t z = (uint64_t(id) << 2 | uint64_t(k)) + 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  z ^= z >> 31;
+  return double(z >> 11) * 0x1.0p-53 - 0.5;
+}
+
 ParticleFrame initialParticles(const Scene& scene) {
   ParticleFrame frame;
   frame.dimensions = scene.dimensions;
@@ -436,6 +446,7 @@ ParticleFrame initialParticles(const Scene& scene) {
   const bool several = scene.severalFluids();
   for (size_t f = 0; f < scene.fluids.size(); ++f) {
     const FluidBlock& fluid = scene.fluids[f];
+    const size_t first = frame.size();
     if (fluid.shaped()) {
       addShapedFluid(scene, f, frame);
     } else {
@@ -450,6 +461,11 @@ ParticleFrame initialParticles(const Scene& scene) {
             frame.id.push_back(static_cast<uint32_t>(frame.id.size()));
           }
     }
+    // Each particle of a jittered block up to jitter x half the spacing off its site along each axis.
+    if (fluid.jitter > 0)
+      for (size_t i = first; i < frame.size(); ++i)
+        for (int k = 0; k < scene.dimensions; ++k)
+          frame.position[i][k] += static_cast<float>(fluid.jitter * spacing * latticeJitter(frame.id[i], k));
     // Where there are several fluids, each block's particles carry its fluid.
     if (several) frame.fluid.resize(frame.size(), static_cast<uint8_t>(scene.fluidOf(f)));
   }

@@ -1,6 +1,7 @@
 // WCSPH's registration (sim/fluid_solver.h): its own scene keys, the defaults and notes it adds, and what it
 // asks of a scene, beside its solver (sim/wcsph_solver.h).
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -30,18 +31,35 @@ void declareWcsphKeys(SceneVisitor& v, SolverSettings& s) {
   v.real("near_pressure", s.near_pressure,
          atLeast(0, "WCSPH: near-pressure stiffness of Clavet et al. 2005's double density relaxation, as a "
                     "force; keeps surface particles apart; 0 turns it off", "m^2/s^2"));
+  v.real("background_pressure", s.background_pressure,
+         atLeast(0, "WCSPH: Adami, Hu and Adams 2013's transport velocity: particles move as if under this extra "
+                    "pressure, which keeps them evenly spaced, while their momentum does not feel it; for fluid "
+                    "that fills its domain (it pulls a free surface apart): about 2 rho_0 c^2; 0 turns it off "
+                    "(docs/viscosity.md)", "Pa"));
 }
 
 // The pressure only turns the energy of compression, which the fall gave, back into motion: a spacing a frame, so
 // that a scene with nothing moving (no gravity) still has a runaway speed above zero.
 int wcsphPushesPerFrame(const Scene&) { return 1; }
 
+// The transport velocity pushes particles out of a free surface: a note where the fluid does not fill the tank.
+std::vector<std::string> wcsphNotes(const Scene& scene) {
+  if (scene.solver.background_pressure <= 0) return {};
+  double tank = 1;
+  for (int k = 0; k < scene.dimensions; ++k) tank *= scene.domain.max[k] - scene.domain.min[k];
+  const double fluid = double(scene.particleCount()) * std::pow(scene.particle_spacing, scene.dimensions);
+  if (scene.emitters.empty() && fluid >= 0.99 * tank) return {};
+  return {"solver.background_pressure pushes the particles of a free surface out of it: it is meant for fluid "
+          "that fills its domain (a periodic box, a closed cavity), and this fluid fills " +
+          std::to_string(int(std::lround(100 * fluid / tank))) + "% of the tank"};
+}
+
 }  // namespace
 
 // Less than PBF's 400 and 250 bytes a particle (no stored pair factors), counted as those.
 const FluidMethod kWcsphMethod = {"wcsph", "weakly compressible SPH (Monaghan 1994, Becker & Teschner 2007)",
     &makeMethod<WcsphSolver, 2>, &makeMethod<WcsphSolver, 3>, 250, 400,
-    &wcsphPushesPerFrame, nullptr, nullptr, &declareWcsphKeys,
+    &wcsphPushesPerFrame, nullptr, &wcsphNotes, &declareWcsphKeys,
     "a smaller solver.cfl or solver.time_step", false};
 
 }  // namespace surge

@@ -29,6 +29,7 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const Collider
   nearStiffness_ = static_cast<float>(s.near_pressure);
   cfl_ = static_cast<float>(s.cfl);
   fixedStep_ = static_cast<float>(s.time_step);
+  backgroundPressure_ = static_cast<float>(s.background_pressure);
 }
 
 template <int Dim>
@@ -37,6 +38,7 @@ void WcsphSolver<Dim>::resizeChannels(size_t n) {
   sizeChannel(density_, n, restDensity_);
   sizeChannel(pressure_, n, 0.0f);
   if (nearStiffness_ > 0) sizeChannel(nearPressure_, n, 0.0f);
+  if (backgroundPressure_ > 0) sizeChannel(transportAcceleration_, n, VecD(VecD::Zero()));
   colliderForces_.assign(colliders_.size(), Wrench{});
   accelerationsValid_ = false;
 }
@@ -97,7 +99,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     });
     if (this->tension_.active()) this->tension_.addWork(v_, dt, this->massRatio_);  // at the half step's velocities
     if (colliding) colliders_.addWrenches(colliderForces_, 0.5 * dt);
-    driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_);
+    drift(dt, 0.5f * dt);
     if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
     computeAccelerations(time + dt);
     parallelFor(0, size(), [&](size_t b, size_t e) {
@@ -112,7 +114,7 @@ long WcsphSolver<Dim>::step(float dt, double time) {
     });
     if (this->tension_.active()) this->tension_.addWork(v_, dt, this->massRatio_);
     if (colliding) colliders_.addWrenches(colliderForces_, dt);
-    driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_);
+    drift(dt, dt);
     if (colliding) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);
     accelerationsValid_ = false;
   }
@@ -121,6 +123,22 @@ long WcsphSolver<Dim>::step(float dt, double time) {
   if (colliding && this->viscosity_.active()) colliders_.addWrenches(colliders_.takeSlotSums(), 1.0);  // its drag
   time_ = time + dt;
   return this->endStep();
+}
+
+// x += dt v against the solids; with the transport velocity, x += dt (v + kick a_b), the solids' stops applied to
+// v alone (the kick is added for the drift and taken back after it).
+template <int Dim>
+void WcsphSolver<Dim>::drift(float dt, float kick) {
+  const bool transport = backgroundPressure_ > 0;
+  if (transport)
+    parallelFor(0, size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) v_[i] += kick * transportAcceleration_[i];
+    });
+  driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_);
+  if (transport)
+    parallelFor(0, size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) v_[i] -= kick * transportAcceleration_[i];
+    });
 }
 
 template <int Dim>
@@ -133,6 +151,7 @@ void WcsphSolver<Dim>::computeAccelerations(double time) {
   }
   kernel_.visit([&](const auto& kernel) {
     computeAccelerationsWith(kernel, time);
+    if (backgroundPressure_ > 0) computeTransportAccelerations(kernel);
     return 0;
   });
   accelerationsValid_ = true;
@@ -249,6 +268,37 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
     this->tension_.addTo(a_);
   }
   if (!colliders_.empty()) colliderForces_ = colliders_.takeSlotSums();
+}
+
+// a_b = -(m_0 / m_i) p_b [sum_j m_0 (1 / rho_i^2 + 1 / rho_j^2) grad W_ij + the walls' and colliders' 2 / rho_i^2
+// gradients] (Adami, Hu and Adams 2013, eq. 14, with the pressure force's mirrored walls), a pass of its own so that
+// a scene without it runs the pressure loop it always did.
+template <int Dim>
+template <typename Kernel>
+void WcsphSolver<Dim>::computeTransportAccelerations(const Kernel& kernel) {
+  const PhaseTimer timer(times_.forces);
+  const float* inverse = inverseMassRatio_.data();
+  this->periodic_.withNearestImage([&](const auto& sharedWrap) {
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
+    for (size_t i = b; i < e; ++i) {
+      const float inverseSquareI = 1.0f / (density_[i] * density_[i]);
+      VecD sum = VecD::Zero();
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
+        VecD r = x_[i] - x_[*j];
+        wrap(r);
+        sum -= (inverseSquareI + 1.0f / (density_[*j] * density_[*j])) * (kernel.gradientFactor(r.norm()) * r);
+      }
+      float unusedWeight = 0;
+      VecD wallGradient = VecD::Zero();
+      walls_.add(x_[i], unusedWeight, wallGradient);
+      if (!colliders_.empty()) colliders_.add(x_[i], unusedWeight, wallGradient);
+      sum -= (2.0f * inverseSquareI) * wallGradient;
+      const float massScale = inverseMassRatio_.empty() ? mass_ : mass_ * inverse[i];
+      transportAcceleration_[i] = (massScale * backgroundPressure_) * sum;
+    }
+  });
+  });
 }
 
 template <int Dim>

@@ -16,6 +16,11 @@
 //   near pressure (opt-in)   Clavet et al. 2005's near density sum_j (1 - q)^3 and near pressure k_near times it,
 //                            as a force pushing close pairs apart
 //   gravity and the attractor (sim/attractor.h)
+//   transport velocity       (opt-in, solver.background_pressure p_b; Adami, Hu and Adams 2013, eq. 13-14) the
+//                            particles move with v + (dt/2) a_b, a_b = -sum_j m p_b (1 / rho_i^2 + 1 / rho_j^2)
+//                            grad W_ij (and the walls' and colliders' share), while v does not feel p_b: the push
+//                            keeps the particles evenly spaced in a flow that stretches the lattice (the extra
+//                            stress term A of the paper is left out: it changed Taylor-Green's energy by < 1%)
 // Time integration: velocity Verlet (kick-drift-kick), or semi-implicit Euler; the step from the CFL condition
 // on c + |v|max, the viscous limit and the force limit (or fixed). The integrator restarts at every output frame
 // from (x, v), so a run resumed from a frame file continues exactly as an uninterrupted one.
@@ -61,6 +66,11 @@ class WcsphSolver final : public ParticleSolver<Dim> {
 
   void resizeChannels(size_t n) override;
   void computeAccelerations(double time);
+  // Adami et al. 2013's a_b into transportAcceleration_ (only with background_pressure > 0).
+  template <typename Kernel>
+  void computeTransportAccelerations(const Kernel& kernel);
+  // The drift of a step dt: with the transport velocity, the particles move with v + kick a_b.
+  void drift(float dt, float kick);
   template <typename Kernel>
   void computeAccelerationsWith(const Kernel& kernel, double time);
 
@@ -68,12 +78,13 @@ class WcsphSolver final : public ParticleSolver<Dim> {
   bool verlet_, tait_;
   SphKernel<Dim> kernel_;
   float support_, smoothingLength_, speedOfSound_, gasConstant_, taitB_;
-  float alpha_, nu_, nearStiffness_, cfl_, fixedStep_;
+  float alpha_, nu_, nearStiffness_, cfl_, fixedStep_, backgroundPressure_;
 
   // WCSPH's channels beside the core's.
   std::vector<VecD> a_;
   std::vector<float> density_, pressure_;
   std::vector<float> nearPressure_;  // only with near_pressure > 0
+  std::vector<VecD> transportAcceleration_;  // a_b at the last evaluation; only with background_pressure > 0
   std::vector<Wrench> colliderForces_;   // each collider's force at the last evaluation (for the impulses)
 
   bool accelerationsValid_ = false;

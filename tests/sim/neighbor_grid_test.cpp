@@ -4,6 +4,10 @@
 
 #include <algorithm>
 #include <random>
+#include <string>
+
+#include "core/scene.h"
+#include "sim/periodic.h"
 
 namespace surge {
 namespace {
@@ -178,6 +182,50 @@ TEST(NeighborGrid, DenseGridCoversOnlyTheParticlesBox) {
   grid.sort(x);
   EXPECT_FALSE(grid.sparse());
   EXPECT_LE(grid.cellCount(), 11u * 11u * 11u);
+}
+
+// A domain that wraps: every pair closer than the radius through the nearest image, found across the seams, for
+// radii that leave the last cell of a period wider than the others (the period is not a whole number of cells).
+template <int Dim>
+void expectPeriodicSameAsBruteForce(const std::string& domain, float radius, size_t count) {
+  const std::string corner = Dim == 2 ? "[0.1, 0.1]" : "[0.1, 0.1, 0.1]", origin = Dim == 2 ? "[0, 0]" : "[0, 0, 0]";
+  const Scene scene = parseScene(R"({"name": "p", "dimensions": )" + std::to_string(Dim) + R"(, "domain": )" + domain +
+                                     R"(, "particle_spacing": 0.01, "fluids": [{"box": {"min": )" + origin +
+                                     R"(, "max": )" + corner + "}}]}",
+                                 "test");
+  const PeriodicDomain<Dim> periodic(scene);
+  const Vec<Dim> lo = toVec<Dim>(scene.domain.min), hi = toVec<Dim>(scene.domain.max);
+  std::mt19937 random(7);
+  std::vector<Vec<Dim>> x(count);
+  for (auto& p : x)
+    for (int k = 0; k < Dim; ++k) p[k] = std::uniform_real_distribution<float>(lo[k], hi[k])(random);
+  for (float cell : {radius, 0.5f * radius}) {
+    SCOPED_TRACE("radius " + std::to_string(radius) + ", cells of " + std::to_string(cell));
+    NeighborGrid<Dim> grid(lo, hi, cell);
+    grid.setPeriodic(periodic);
+    grid.sort(x);
+    std::vector<Vec<Dim>> sorted = x, scratch;
+    gatherByOrder(grid.sortedOrder(), sorted, scratch);
+    NeighborLists lists;
+    grid.findNeighbors(sorted, radius, lists);
+    for (size_t i = 0; i < sorted.size(); ++i) {
+      std::vector<uint32_t> expected;
+      for (size_t j = 0; j < sorted.size(); ++j) {
+        Vec<Dim> r = sorted[i] - sorted[j];
+        for (int k = 0; k < Dim; ++k) r[k] = periodic.component(k, r[k]);
+        if (i != j && r.squaredNorm() < radius * radius) expected.push_back(uint32_t(j));
+      }
+      std::vector<uint32_t> got(lists.begin(i), lists.end(i));
+      std::sort(got.begin(), got.end());
+      ASSERT_EQ(got, expected) << "particle " << i << " at " << sorted[i].transpose();
+    }
+  }
+}
+
+TEST(NeighborGrid, PeriodicAxesMatchBruteForceAcrossTheSeams) {
+  for (float radius : {0.0583333f, 0.0675f, 0.1075f})
+    expectPeriodicSameAsBruteForce<2>(R"({"min": [0, 0], "max": [1, 1], "periodic": ["x", "y"]})", radius, 3000);
+  expectPeriodicSameAsBruteForce<3>(R"({"min": [0, 0, 0], "max": [0.5, 0.4, 0.3], "periodic": ["x", "z"]})", 0.07f, 3000);
 }
 
 }  // namespace
