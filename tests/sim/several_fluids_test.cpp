@@ -129,6 +129,39 @@ TEST_P(SeveralFluidsByMethod, SameBytesAtAnyThreadCountAndAfterAResume) {
   EXPECT_NE(one.find("property uchar fluid"), std::string::npos);
 }
 
+// WCSPH's equation of state at each fluid's own rest density (p times m_f / m_0, computeAccelerationsWith): within
+// one fluid the pressure force over the particle's mass is then water's, so a column three times as dense as water
+// settles exactly as a water column does. Two scenes, each a column 0.2 x 0.4 m (c = 10 m/s, so it compresses by
+// up to g h / c^2 = 3.9%) held between the tank's wall and a block, a small pool of the other fluid beyond the
+// block: water's column (fluid 0) and the heavy one's (fluid 1, m_f / m_0 = 3). Their mean heights over the second second agree within 1 mm (a twentieth
+// of a spacing; the same equations up to rounding). With water's stiffness for the heavy fluid it would compress
+// three times as much and settle about 8 mm lower (g h^2 / (2 c^2) at the top, twice over).
+TEST(SeveralFluids, WcsphGivesEachFluidItsOwnStiffness) {
+  const auto column = [](const std::string& fluids, const std::string& name, uint8_t fluid) {
+    const Scene scene = parseScene(R"({"name": "stiffness", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.8, 0.6]},
+      "particle_spacing": 0.02, "fluids": )" + fluids + R"(,
+      "colliders": [{"shape": "box", "position": [0.45, 0.3], "size": [0.5, 0.6]}],
+      "solver": {"method": "wcsph", "speed_of_sound": 10}, "output": {"fps": 30, "frames": 60}})",
+                                   "test");
+    const fs::path dir = runScene(scene, "several_fluids_stiffness_" + name);
+    double sum = 0;
+    for (int f = 31; f <= 60; ++f) {
+      char file[32];
+      std::snprintf(file, sizeof file, "frame_%05d.ply", f);
+      sum += meanHeight(readParticlePly(dir / "particles" / file), fluid);
+    }
+    return sum / 30;
+  };
+  const double water = column(R"([{"box": {"min": [0, 0], "max": [0.2, 0.4]}},
+                                   {"name": "heavy", "rest_density": 3000, "box": {"min": [0.7, 0], "max": [0.8, 0.04]}}])",
+                              "water", 0);
+  const double heavy = column(R"([{"box": {"min": [0.7, 0], "max": [0.8, 0.04]}},
+                                   {"name": "heavy", "rest_density": 3000, "box": {"min": [0, 0], "max": [0.2, 0.4]}}])",
+                              "heavy", 1);
+  std::printf("WCSPH columns at rest: water's mean height %.5f m, the heavy fluid's %.5f m\n", water, heavy);
+  EXPECT_NEAR(heavy, water, 0.001);
+}
+
 // A scene of one fluid writes no `fluid` property: its frames stay as they were.
 TEST(SeveralFluids, OneFluidWritesNoFluidProperty) {
   const Scene scene = parseScene(R"({"name": "one", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.4, 0.4]},
