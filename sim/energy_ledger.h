@@ -1,7 +1,8 @@
 // The fluid's energy account (issue 32). Its mechanical energy E is the kinetic energy and the potential energy
 // against the tank's floor; its sources' work W (stats.csv's source_work, cumulative from frame 0) is what the
 // moving colliders and bodies did on it (sim/colliders.h, Wrench::work), what the attractor did, and the energy
-// the emitters bring in and steer, less what the sinks and open faces carry out (sim/sources.h). Every method
+// the emitters bring in and steer, less what the sinks and open faces carry out (sim/sources.h), and the
+// compression a jittered start holds in WCSPH (FluidSolver::compressionEnergy, in frame 1's). Every method
 // dissipates (walls stop what hits them; viscosity, PBF's projection), so E - W never rises above frame 0's in
 // a run that is right; the ledger stops a run whose E - E(0) - W passes tolerance().
 #pragma once

@@ -94,6 +94,10 @@ class FluidSolver {
   // The work the method's cohesive forces (surface tension, adhesion) did on the fluid since the last call (J):
   // surface energy turned into motion, which the energy account counts as a source's work.
   virtual double takeForceWork() { return 0; }
+  // The energy the fluid holds in its compression now (J), which a compressible method gives back as motion: a
+  // jittered start's (fluids[i].jitter), which the energy account counts as a source's work. 0 for the methods
+  // that project the compression away.
+  virtual double compressionEnergy() { return 0; }
 
   // The colliders and bodies the fluid meets (empty without them); the bodies' coupling sets their poses.
   virtual Colliders<Dim>& colliders() = 0;

@@ -195,6 +195,10 @@ class FrameLoop final : public SimulationRun {
       if (solver.lastDivergenceIterations() >= 0) record_.divergenceIterations = 0;
       if (solver.lastViscosityIterations() >= 0) record_.viscosityIterations = 0;
       writeFrame();
+      // A jittered start's compression, which a compressible method gives back as motion, is a source's work
+      // (in frame 1's source_work).
+      if (std::any_of(scene_.fluids.begin(), scene_.fluids.end(), [](const FluidBlock& f) { return f.jitter > 0; }))
+        ledger_->add(solver.compressionEnergy());
     }
   }
 

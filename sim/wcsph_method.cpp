@@ -44,14 +44,22 @@ int wcsphPushesPerFrame(const Scene&) { return 1; }
 
 // The transport velocity pushes particles out of a free surface: a note where the fluid does not fill the tank.
 std::vector<std::string> wcsphNotes(const Scene& scene) {
-  if (scene.solver.background_pressure <= 0) return {};
+  std::vector<std::string> notes;
+  for (size_t i = 0; i < scene.fluids.size(); ++i)
+    if (scene.fluids[i].jitter > 0) {
+      notes.push_back("fluids[" + std::to_string(i) + "].jitter starts WCSPH's fluid compressed, and it gives that "
+                      "energy back as motion (the energy account credits it in frame 1's source_work)");
+      break;
+    }
+  if (scene.solver.background_pressure <= 0) return notes;
   double tank = 1;
   for (int k = 0; k < scene.dimensions; ++k) tank *= scene.domain.max[k] - scene.domain.min[k];
   const double fluid = double(scene.particleCount()) * std::pow(scene.particle_spacing, scene.dimensions);
-  if (scene.emitters.empty() && fluid >= 0.99 * tank) return {};
-  return {"solver.background_pressure pushes the particles of a free surface out of it: it is meant for fluid "
-          "that fills its domain (a periodic box, a closed cavity), and this fluid fills " +
-          std::to_string(int(std::lround(100 * fluid / tank))) + "% of the tank"};
+  if (scene.emitters.empty() && fluid >= 0.99 * tank) return notes;
+  notes.push_back("solver.background_pressure pushes the particles of a free surface out of it: it is meant for "
+                  "fluid that fills its domain (a periodic box, a closed cavity), and this fluid fills " +
+                  std::to_string(int(std::lround(100 * fluid / tank))) + "% of the tank");
+  return notes;
 }
 
 }  // namespace

@@ -301,6 +301,23 @@ void WcsphSolver<Dim>::computeTransportAccelerations(const Kernel& kernel) {
   });
 }
 
+// With x = rho / rho_0: Tait's e = (B / rho_0) ((x^6 - 1) / 6 + 1 / x - 1), the gas law's e = k (ln x + 1 / x - 1);
+// each fluid's pressure is m_f / m_0 times the one fluid's (computeAccelerationsWith), and so is its energy a mass.
+template <int Dim>
+double WcsphSolver<Dim>::compressionEnergy() {
+  if (neighbors_.size() != size()) computeAccelerations(time_);
+  double energy = 0;
+  for (size_t i = 0; i < size(); ++i) {
+    const double x = double(density_[i]) / restDensity_;
+    if (x <= 1) continue;
+    const double e = tait_ ? double(taitB_) / restDensity_ * ((std::pow(x, 6) - 1) / 6 + 1 / x - 1)
+                           : double(gasConstant_) * (std::log(x) + 1 / x - 1);
+    const double ratio = massRatio_.empty() ? 1.0 : double(massRatio_[i]);
+    energy += double(mass_) * ratio * ratio * e;
+  }
+  return energy;
+}
+
 template <int Dim>
 FluidMeasures WcsphSolver<Dim>::measure() {
   if (neighbors_.size() != size()) computeAccelerations(time_);

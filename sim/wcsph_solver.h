@@ -56,6 +56,9 @@ class WcsphSolver final : public ParticleSolver<Dim> {
   float maxPressure() const override { return framePressureMax_; }
   int lastIterations() const override { return 0; }
   float speedOfSound() const { return speedOfSound_; }
+  // sum_i m_i e(rho_i), e the equation of state's internal energy, int p / rho^2 d rho from rest (zero below it,
+  // where the pressure is clamped).
+  double compressionEnergy() override;
   // Pressures of the last evaluation, in the particles' current order (for tests).
   const std::vector<float>& pressures() const { return pressure_; }
 
