@@ -139,7 +139,7 @@ struct FluidBlock {
   std::string name;
   double rest_density = 0;  // kg/m^3 (kg/m^2 in 2D); 0 in the file: solver.rest_density (resolved)
   Eigen::Vector3d color = Eigen::Vector3d::Zero();  // the render's water colour; zero: render.water_color (resolved)
-  double jitter = 0;  // each particle off its lattice site by up to jitter x half the spacing per axis; 0 none
+  double jitter = 0;  // each particle off its lattice site by up to jitter x half the spacing per axis (<= 0.5)
 
   bool shaped() const { return !solid.shape.empty(); }
   static ColliderSettings shapeless() {

@@ -218,8 +218,9 @@ void visitScene(Scene& s, SceneVisitor& v) {
                  true);
         v.real("jitter", f.jitter,
                atLeast(0, "each particle starts off its lattice site by up to this fraction of half the spacing "
-                          "along each axis (a fixed pattern, by particle), still inside its own lattice cell: a "
-                          "square lattice's rows can then not snap all at once; 0: on the lattice", "", 1));
+                          "along each axis (a fixed pattern, by particle): a square lattice's rows can then not "
+                          "snap all at once; at most 0.5, so that no pair starts closer than 0.5 spacing (WCSPH "
+                          "gives the compression back as motion); 0: on the lattice", "", 0.5));
       });
   v.vector("gravity", s.gravity, info("gravitational acceleration", "m/s^2"));
   v.group("attractor", info("a point moving along keyframes that pulls (or pushes) particles near it"), [&] {

@@ -301,8 +301,9 @@ void WcsphSolver<Dim>::computeTransportAccelerations(const Kernel& kernel) {
   });
 }
 
-// With x = rho / rho_0: Tait's e = (B / rho_0) ((x^6 - 1) / 6 + 1 / x - 1), the gas law's e = k (ln x + 1 / x - 1);
-// each fluid's pressure is m_f / m_0 times the one fluid's (computeAccelerationsWith), and so is its energy a mass.
+// With x = rho / rho_0: Tait's e = (B / rho_0) ((x^6 - 1) / 6 + 1 / x - 1), the gas law's e = k (ln x + 1 / x - 1).
+// A fluid's pressure is m_f / m_0 times the one fluid's and its particles as much heavier (computeAccelerationsWith),
+// so it moves as water would and holds m_i e.
 template <int Dim>
 double WcsphSolver<Dim>::compressionEnergy() {
   if (neighbors_.size() != size()) computeAccelerations(time_);
@@ -313,7 +314,7 @@ double WcsphSolver<Dim>::compressionEnergy() {
     const double e = tait_ ? double(taitB_) / restDensity_ * ((std::pow(x, 6) - 1) / 6 + 1 / x - 1)
                            : double(gasConstant_) * (std::log(x) + 1 / x - 1);
     const double ratio = massRatio_.empty() ? 1.0 : double(massRatio_[i]);
-    energy += double(mass_) * ratio * ratio * e;
+    energy += double(mass_) * ratio * e;
   }
   return energy;
 }
