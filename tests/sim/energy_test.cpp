@@ -131,8 +131,8 @@ TEST(Energy, TheAttractorsWorkIsTheEnergyItGives) {
 // A jittered start (fluids[i].jitter) compresses WCSPH's fluid, which gives that energy back as motion: the account
 // credits the compression, sum_i m_i e(rho_i) of the equation of state, as frame 1's source work (frame 0's is 0),
 // so the run goes on. Without the credit this pool (0.4 x 0.2 m, jitter 0.4) turns 117 of its 208 J/m of
-// compression into motion and height in its first frame, and the energy stop ends it there. The same pool on the lattice is credited
-// nothing.
+// compression into motion and height in its first frame, and the energy stop ends it there. The same pool on the
+// lattice is credited nothing.
 TEST(Energy, AJitteredWcsphStartIsCreditedItsCompression) {
   const std::string json = R"({"name": "jittered", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.4, 0.4]},
       "particle_spacing": 0.01, "fluids": [{"box": {"min": [0, 0], "max": [0.4, 0.2]}}],

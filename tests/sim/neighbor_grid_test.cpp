@@ -225,7 +225,8 @@ void expectPeriodicSameAsBruteForce(const std::string& domain, float radius, siz
 TEST(NeighborGrid, PeriodicAxesMatchBruteForceAcrossTheSeams) {
   for (float radius : {0.0583333f, 0.0675f, 0.1075f})
     expectPeriodicSameAsBruteForce<2>(R"({"min": [0, 0], "max": [1, 1], "periodic": ["x", "y"]})", radius, 3000);
-  expectPeriodicSameAsBruteForce<3>(R"({"min": [0, 0, 0], "max": [0.5, 0.4, 0.3], "periodic": ["x", "z"]})", 0.07f, 3000);
+  expectPeriodicSameAsBruteForce<3>(R"({"min": [0, 0, 0], "max": [0.5, 0.4, 0.3], "periodic": ["x", "z"]})", 0.07f,
+                                    3000);
 }
 
 }  // namespace

@@ -133,8 +133,8 @@ TEST_P(SeveralFluidsByMethod, SameBytesAtAnyThreadCountAndAfterAResume) {
 // one fluid the pressure force over the particle's mass is then water's, so a column three times as dense as water
 // settles exactly as a water column does. Two scenes, each a column 0.2 x 0.4 m (c = 10 m/s, so it compresses by
 // up to g h / c^2 = 3.9%) held between the tank's wall and a block, a small pool of the other fluid beyond the
-// block: water's column (fluid 0) and the heavy one's (fluid 1, m_f / m_0 = 3). Their mean heights over the second second agree within 1 mm (a twentieth
-// of a spacing; the same equations up to rounding). With water's stiffness for the heavy fluid it would compress
+// block: water's column (fluid 0) and the heavy one's (fluid 1, m_f / m_0 = 3). Their mean heights over the second
+// second agree within 1 mm (a twentieth of a spacing; the same equations up to rounding). With water's stiffness for the heavy fluid it would compress
 // three times as much and settle about 8 mm lower (g h^2 / (2 c^2) at the top, twice over).
 TEST(SeveralFluids, WcsphGivesEachFluidItsOwnStiffness) {
   const auto column = [](const std::string& fluids, const std::string& name, uint8_t fluid) {
@@ -145,11 +145,7 @@ TEST(SeveralFluids, WcsphGivesEachFluidItsOwnStiffness) {
                                    "test");
     const fs::path dir = runScene(scene, "several_fluids_stiffness_" + name);
     double sum = 0;
-    for (int f = 31; f <= 60; ++f) {
-      char file[32];
-      std::snprintf(file, sizeof file, "frame_%05d.ply", f);
-      sum += meanHeight(readParticlePly(dir / "particles" / file), fluid);
-    }
+    for (int f = 31; f <= 60; ++f) sum += meanHeight(readParticlePly(framePath(dir, "particles", f, "ply")), fluid);
     return sum / 30;
   };
   const double water = column(R"([{"box": {"min": [0, 0], "max": [0.2, 0.4]}},
