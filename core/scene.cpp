@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/expression.h"
 #include "core/errors.h"
 #include "core/scene_fields.h"
 
@@ -193,6 +194,26 @@ class JsonReader : public SceneVisitor {
     }
   }
 
+  void formulas(const char* key, std::vector<std::string>& values, const FieldInfo& info) override {
+    if (const json* j = find(key, info)) {
+      const size_t n = static_cast<size_t>(scene_.dimensions);
+      if (!j->is_array() || j->size() != n)
+        fail(key, "expected an array of " + std::to_string(n) + " formulas (strings or numbers), got " + describe(*j));
+      values.clear();
+      for (size_t k = 0; k < n; ++k) {
+        const json& item = (*j)[k];
+        failIfNonFinite(key, item);
+        if (!item.is_string() && !item.is_number()) fail(key, "expected formulas (strings or numbers), got " + describe(*j));
+        values.push_back(item.is_string() ? item.get<std::string>() : item.dump());
+        try {
+          (void)Expression(values.back());
+        } catch (const ExpressionError& e) {
+          throw error(path(key) + "[" + std::to_string(k) + "]", "'" + values.back() + "': " + e.what());
+        }
+      }
+    }
+  }
+
   void group(const char* key, const FieldInfo& info, const std::function<void()>& body) override {
     const json* j = find(key, info);
     if (!j) return;
@@ -296,6 +317,9 @@ class JsonWriter : public SceneVisitor {
   void reals(const char* key, std::vector<double>& values, const FieldInfo&) override {
     if (!values.empty()) (*stack_.back())[key] = values;
   }
+  void formulas(const char* key, std::vector<std::string>& values, const FieldInfo&) override {
+    if (!values.empty()) (*stack_.back())[key] = values;
+  }
   void group(const char* key, const FieldInfo&, const std::function<void()>& body) override {
     json& child = (*stack_.back())[key] = json::object();
     stack_.push_back(&child);
@@ -351,6 +375,9 @@ class KeyTable : public SceneVisitor {
   }
   void reals(const char* key, std::vector<double>&, const FieldInfo& info) override {
     row(key, "numbers", "", info);
+  }
+  void formulas(const char* key, std::vector<std::string>&, const FieldInfo& info) override {
+    row(key, "formulas", "", info);
   }
   void group(const char* key, const FieldInfo& info, const std::function<void()>& body) override {
     row(key, "object", "", info);

@@ -133,6 +133,7 @@ struct FluidBlock {
   Box box;
   ColliderSettings solid = shapeless();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  std::vector<std::string> velocity_field;  // a formula of x, y, z per component, added to velocity; empty none
   double surface_tension = 0;  // sigma, N/m (N in 2D); 0 none
   double viscosity = 0;        // kinematic nu, m^2/s (sim/viscosity.h); 0 none
   // The fluid it is (blocks of one name are one fluid). Empty in the file: "water" (resolved).

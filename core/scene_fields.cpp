@@ -199,6 +199,10 @@ void visitScene(Scene& s, SceneVisitor& v) {
         visitBox(v, "box", f.box, "the block, filled with particles at cell centres of the lattice; or give a shape");
         visitShapeKeys(v, f.solid, false);
         v.vector("velocity", f.velocity, info("initial velocity", "m/s"));
+        v.formulas("velocity_field", f.velocity_field,
+                   info("an initial velocity field added to velocity: one formula of the position x, y, z (m) per "
+                        "component, such as \"-cos(2*pi*x)*sin(2*pi*y)\" (numbers, pi, + - * / ^, sin, cos, tan, "
+                        "exp, log, sqrt, abs, tanh, atan2, min, max, pow, ...)", "m/s"));
         v.real("surface_tension", f.surface_tension,
                atLeast(0, "surface tension sigma against air (water 0.0728; N in 2D), by "
                           "solver.surface_tension_model; 0 turns it off", "N/m"));

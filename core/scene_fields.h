@@ -35,6 +35,8 @@ class SceneVisitor {
   virtual void vector(const char* key, Eigen::Vector3d& value, const FieldInfo& info, bool always3 = false) = 0;
   // An array of 1 to 3 numbers whose length depends on the context (a box's size, a heightfield's extents).
   virtual void reals(const char* key, std::vector<double>& values, const FieldInfo& info) = 0;
+  // One formula of x, y, z per component (core/expression.h), `dimensions` of them; a number is a formula too.
+  virtual void formulas(const char* key, std::vector<std::string>& values, const FieldInfo& info) = 0;
   virtual void group(const char* key, const FieldInfo& info, const std::function<void()>& body) = 0;
   // A list of objects: size(), resize(n), and visitItem(i) which visits item i's fields.
   virtual void list(const char* key, const FieldInfo& info, const std::function<size_t()>& size,

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.h"
+#include "core/expression.h"
 #include "core/parallel.h"
 #include "core/scene_fields.h"
 #include "geometry/collider_shape.h"
@@ -439,6 +440,21 @@ static double latticeJitter(uint32_t id, int k) {
   return double(z >> 11) * 0x1.0p-53 - 0.5;
 }
 
+// fluids[f].velocity_field, each component's formula at each particle's starting place, added to its velocity.
+static void addVelocityField(const Scene& scene, size_t f, size_t first, ParticleFrame& frame) {
+  for (int k = 0; k < scene.dimensions; ++k) {
+    const std::string& text = scene.fluids[f].velocity_field[k];
+    const Expression formula(text);  // the scene's reader has parsed it once already
+    for (size_t i = first; i < frame.size(); ++i) {
+      const double value = formula(frame.position[i].cast<double>());
+      if (!std::isfinite(value))
+        throw InputError(scene.source, "fluids[" + std::to_string(f) + "].velocity_field[" + std::to_string(k) + "]",
+                         "'" + text + "' is not finite at " + formatVector(frame.position[i], scene.dimensions));
+      frame.velocity[i][k] += static_cast<float>(value);
+    }
+  }
+}
+
 ParticleFrame initialParticles(const Scene& scene) {
   ParticleFrame frame;
   frame.dimensions = scene.dimensions;
@@ -470,6 +486,7 @@ ParticleFrame initialParticles(const Scene& scene) {
       for (size_t i = first; i < frame.size(); ++i)
         for (int k = 0; k < scene.dimensions; ++k)
           frame.position[i][k] += static_cast<float>(fluid.jitter * spacing * latticeJitter(frame.id[i], k));
+    if (!fluid.velocity_field.empty()) addVelocityField(scene, f, first, frame);
     // Where there are several fluids, each block's particles carry its fluid.
     if (several) frame.fluid.resize(frame.size(), static_cast<uint8_t>(scene.fluidOf(f)));
   }

@@ -82,6 +82,35 @@ TEST(FluidSolver, AJitteredBlockStartsOffItsLatticeWithinItsCellsTheSameEveryRun
   EXPECT_NEAR(sum / 3000, 0.0, 0.008);
 }
 
+// fluids[i].velocity_field: each particle starts with velocity plus the formulas at its own (jittered) place, in
+// its own block only; a formula that is not finite somewhere in the block is one line naming the component's key.
+TEST(FluidSolver, AVelocityFieldStartsEachParticleWithTheFormulaAtItsPlace) {
+  const std::string json = R"({"name": "f", "dimensions": 2, "domain": {"min": [0, 0], "max": [1, 1]},
+      "particle_spacing": 0.05,
+      "fluids": [{"box": {"min": [0, 0], "max": [0.5, 0.5]}, "jitter": 0.3, "velocity": [1, 0],
+                  "velocity_field": ["y", "-x*x"]},
+                 {"box": {"min": [0.5, 0], "max": [1, 0.5]}, "velocity": [0, 2]}]})";
+  const ParticleFrame frame = initialParticles(parseScene(json, "test"));
+  ASSERT_EQ(frame.size(), 200u);
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const Eigen::Vector3f p = frame.position[i], v = frame.velocity[i];
+    if (p.x() < 0.5) {
+      EXPECT_FLOAT_EQ(v.x(), 1 + p.y());
+      EXPECT_FLOAT_EQ(v.y(), -p.x() * p.x());
+      EXPECT_NE(std::fmod(p.y() / 0.05, 1.0), 0.5);  // at the jittered place, not the site
+    } else {
+      EXPECT_EQ(v, Eigen::Vector3f(0, 2, 0));
+    }
+  }
+  try {
+    initialParticles(parseScene(json, "test", {R"X(fluids[0].velocity_field=["1", "sqrt(x - 0.3)"])X"}));
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("test: fluids[0].velocity_field[1]: 'sqrt(x - 0.3)' is not finite at (", 0), 0u)
+        << e.what();
+  }
+}
+
 TEST(FluidSolver, AnUnregisteredMethodIsOneLineNamingTheKey) {
   Scene scene = blockScene("pbf");
   scene.solver.method = "sticky";
