@@ -208,7 +208,9 @@ class JsonReader : public SceneVisitor {
         try {
           (void)Expression(values.back());
         } catch (const ExpressionError& e) {
-          throw error(path(key) + "[" + std::to_string(k) + "]", "'" + values.back() + "': " + e.what());
+          // Named as the component, from the file or --set as the array came (error() matches whole keys).
+          throw InputError(overridden_.count(path(key)) ? "--set" : where_, path(key) + "[" + std::to_string(k) + "]",
+                           "'" + values.back() + "': " + e.what());
         }
       }
     }

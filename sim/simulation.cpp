@@ -367,7 +367,7 @@ void addShapedFluid(const Scene& scene, size_t index, ParticleFrame& frame) {
 
 template <int Dim>
 void checkStart(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes) {
-  ParticleFrame initial = initialParticles(scene);  // refuses a shape that holds no site, an open mesh
+  ParticleFrame initial = initialParticles(scene);  // refuses a shape that holds no site, an open mesh, a formula
   if (!scene.hasSources()) return;
   const std::unique_ptr<FluidSolver<Dim>> solver = makeFluidSolver<Dim>(scene, std::move(shapes));
   if (hasSolids(scene)) removeParticlesInside(solver->colliders(), initial);
@@ -379,9 +379,10 @@ void checkStart(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes
 }  // namespace
 
 void checkSimulationStart(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes) {
-  const bool shaped =
-      std::any_of(scene.fluids.begin(), scene.fluids.end(), [](const FluidBlock& f) { return f.shaped(); });
-  if (!shaped && !scene.hasSources()) return;
+  // A shape that holds no site, a formula not finite somewhere in its block: found by initialParticles.
+  const bool built = std::any_of(scene.fluids.begin(), scene.fluids.end(),
+                                 [](const FluidBlock& f) { return f.shaped() || !f.velocity_field.empty(); });
+  if (!built && !scene.hasSources()) return;
   if (scene.dimensions == 2) checkStart<2>(scene, std::move(shapes));
   else checkStart<3>(scene, std::move(shapes));
 }

@@ -56,6 +56,24 @@ TEST(SimCommand, DivergenceStopsWithFrameSubstepAndParticle) {
   EXPECT_EQ(readParticlePly(framePath(out, "particles", 0, "ply")).size(), 8u);
 }
 
+// fluids[i].velocity_field with a formula that parses but is not finite somewhere in its block (a square root of
+// a negative x): one line naming the component, exit 2, no output folder (checked before the run starts).
+TEST(SimCommand, AVelocityFieldNotFiniteInItsBlockIsOneLineAndWritesNothing) {
+  std::string text = kSmallDamBreak;
+  text.replace(text.find("}]"), 0, R"X(, "velocity_field": ["0", "sqrt(x - 0.1)", "0"])X");
+  const fs::path scene = writeTestScene("field_not_finite.json", text);
+  const fs::path out = freshFolder("surge_field_not_finite");
+  fs::remove_all(out);
+  for (const char* command : {"run", "sim"}) {
+    const SurgeResult r = runSurge(std::string(command) + " '" + scene.string() + "' --out '" + out.string() + "'");
+    EXPECT_EQ(r.status, 2) << command;
+    EXPECT_NE(r.err.find("field_not_finite.json: fluids[0].velocity_field[1]: 'sqrt(x - 0.1)' is not finite at ("),
+              std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << command;
+  }
+}
+
 TEST(SimCommand, ResumeRefusesChangedPhysicsButTakesMoreFramesAndOtherRendering) {
   const fs::path scene = writeTestScene("small.json", kSmallDamBreak);
   const fs::path out = freshFolder("surge_resume_changed");

@@ -76,6 +76,12 @@ TEST(Expression, ASceneReadsAVelocityFieldNamingTheComponentAtFault) {
   };
   EXPECT_EQ(error(R"(["x", "y +"])"),
             "field.json: fluids[0].velocity_field[1]: 'y +': a number, a name or '(' expected at the end");
+  try {
+    parseScene(base + R"(["x", "y"]}]})", "field.json", {R"X(fluids[0].velocity_field=["x", "(y"])X"});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "--set: fluids[0].velocity_field[1]: '(y': ')' expected at the end");
+  }
   EXPECT_NE(error(R"(["x"])").find("fluids[0].velocity_field: expected an array of 2 formulas"), std::string::npos);
   EXPECT_NE(error(R"(["x", true])").find("fluids[0].velocity_field: expected formulas"), std::string::npos);
 }
