@@ -101,6 +101,7 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   double maxDensityError_, maxDivergenceError_;
   int maxIterations_;
   float cfl_, maxStep_, xsphC_;
+  float relaxation_;  // the Jacobi relaxation omega for this kernel and spacing (jacobiRelaxation)
 
   // DFSPH's channels beside the core's.
   std::vector<float> densityRatio_;  // rho_i / rho_0 at the current positions

@@ -183,6 +183,25 @@ TEST(SurfaceTension, ABoxDropRoundsAndItsEnergyIsAccounted) {
   EXPECT_LE(stats.at("kinetic_energy").back(), work);
 }
 
+// The bound on rounding, 2% anisotropy, met where it is: the same box in DFSPH 3D from a start jittered by
+// 0.2 (fluids[i].jitter), read at 1 and 1.5 s. From the lattice it keeps a set of 2.4 to 3.2%; jittered, measured
+// 1.4% and 1.3% (docs/surface-tension.md has the other methods and 2D, which do not meet it).
+TEST(SurfaceTension, AJitteredBoxDropRoundsToWithinTwoPercentInDfsph3D) {
+  Scene scene = dropScene(3, "dfsph", 0.012);
+  scene.fluids[0].box.min = Eigen::Vector3d(-0.012, -0.006, -0.006);
+  scene.fluids[0].box.max = Eigen::Vector3d(0.012, 0.006, 0.006);
+  scene.fluids[0].jitter = 0.2;
+  scene.output.frames = 45;
+  const fs::path dir = runScene(scene, "jittered_box_drop");
+  for (const int frame : {30, 45}) {
+    std::vector<Vec<3>> x;
+    for (const auto& p : readParticlePly(framePath(dir, "particles", frame, "ply")).position) x.push_back(p);
+    const double value = anisotropy<3>(x);
+    std::printf("frame %d: anisotropy %.4f\n", frame, value);
+    EXPECT_LT(value, 0.02) << "frame " << frame;
+  }
+}
+
 // Surface tension keeps a run's bytes the same at any thread count, and a resumed run ends where an uninterrupted
 // one does (2D and 3D).
 TEST(SurfaceTension, SameBytesAtAnyThreadCountAndAfterAResume) {
