@@ -5,8 +5,9 @@
 #   the forces phase (stats.csv ms_viscosity: gravity, XSPH and the viscosity) a step;
 # - periodic axes: a 3D pool at rest (50 x 20 x 50 particles) periodic along x and z beside the same pool between
 #   walls, ms a step, in each method;
-# - WCSPH's transport velocity (solver.background_pressure): Taylor-Green's box (2D, 100 x 100 particles, periodic,
-#   a uniform flow, jittered) with p_b = 2e5 Pa beside p_b = 0, ms a step and the forces phase a step.
+# - the transport velocity (solver.background_pressure): Taylor-Green's box (2D, 100 x 100 particles, periodic,
+#   a uniform flow, jittered) with p_b = 2e5 Pa (WCSPH) and 1e4 Pa (DFSPH, XSPH off) beside p_b = 0, ms a step and
+#   the forces phase a step.
 #
 #   scripts/bench_viscosity.sh [SURGE_BINARY] [FRAMES] [POOL_FRAMES]   (defaults 30 and 10: WCSPH's pool takes
 #   about 5 s a frame)
@@ -59,4 +60,15 @@ read -r plain plainPhase < <(best "$work/box.json" --set output.frames="$pool_fr
 read -r pushed pushedPhase < <(best "$work/box.json" --set output.frames="$pool_frames" --set solver.background_pressure=2e5)
 awk -v a="$plain" -v b="$pushed" -v pa="$plainPhase" -v pb="$pushedPhase" 'BEGIN {
   printf "| p_b = 0 | %.3f | %.3f |\n| p_b = 2e5 Pa | %.3f | %.3f |\n| ratio | %.3f | transport velocity %.0f%% of a step |\n",
+         a, pa, b, pb, b / a, 100 * (b - a) / b }'
+
+echo
+echo "| Taylor-Green's box, DFSPH | ms a step | forces phase, ms a step |"
+echo "|---|---|---|"
+sed 's/"method": "wcsph", "speed_of_sound": 10,/"method": "dfsph", "xsph_c": 0,/' "$work/box.json" >"$work/box_dfsph.json"
+read -r plain plainPhase < <(best "$work/box_dfsph.json" --set output.frames="$pool_frames")
+read -r pushed pushedPhase < <(best "$work/box_dfsph.json" --set output.frames="$pool_frames" \
+  --set solver.background_pressure=1e4)
+awk -v a="$plain" -v b="$pushed" -v pa="$plainPhase" -v pb="$pushedPhase" 'BEGIN {
+  printf "| p_b = 0 | %.3f | %.3f |\n| p_b = 1e4 Pa | %.3f | %.3f |\n| ratio | %.3f | transport velocity %.0f%% of a step |\n",
          a, pa, b, pb, b / a, 100 * (b - a) / b }'

@@ -488,9 +488,11 @@ size_t removeParticlesInside(const Colliders<Dim>& colliders, ParticleFrame& fra
 
 template <int Dim>
 void driftAgainstSolids(std::vector<Vec<Dim>>& x, std::vector<Vec<Dim>>& v, float dt, float referenceMass,
-                        const std::vector<float>& massRatio, Colliders<Dim>& colliders, const TankWalls<Dim>& walls) {
+                        const std::vector<float>& massRatio, Colliders<Dim>& colliders, const TankWalls<Dim>& walls,
+                        const std::vector<Vec<Dim>>* push, float pushScale) {
   parallelFor(0, x.size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
+      if (push) v[i] += pushScale * (*push)[i];
       const Vec<Dim> from = x[i];
       const float mass = massRatio.empty() ? referenceMass : referenceMass * massRatio[i];
       x[i] += dt * v[i];
@@ -510,6 +512,7 @@ void driftAgainstSolids(std::vector<Vec<Dim>>& x, std::vector<Vec<Dim>>& v, floa
       const int moved = walls.clamp(x[i]);
       for (int k = 0; k < Dim; ++k)
         if (moved & (1 << k)) v[i][k] = 0;
+      if (push) v[i] -= pushScale * (*push)[i];
     }
   });
 }
@@ -519,8 +522,8 @@ template class Colliders<3>;
 template size_t removeParticlesInside(const Colliders<2>&, ParticleFrame&);
 template size_t removeParticlesInside(const Colliders<3>&, ParticleFrame&);
 template void driftAgainstSolids(std::vector<Vec<2>>&, std::vector<Vec<2>>&, float, float, const std::vector<float>&,
-                                 Colliders<2>&, const TankWalls<2>&);
+                                 Colliders<2>&, const TankWalls<2>&, const std::vector<Vec<2>>*, float);
 template void driftAgainstSolids(std::vector<Vec<3>>&, std::vector<Vec<3>>&, float, float, const std::vector<float>&,
-                                 Colliders<3>&, const TankWalls<3>&);
+                                 Colliders<3>&, const TankWalls<3>&, const std::vector<Vec<3>>*, float);
 
 }  // namespace surge

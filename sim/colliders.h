@@ -359,10 +359,12 @@ size_t removeParticlesInside(const Colliders<Dim>& colliders, ParticleFrame& fra
 // response. A particle stopped at a collider loses its velocity into it, relative to the wall's own, and that
 // change is the collider's impulse; friction acts on the particles touching one; at a tank wall the particle is
 // clamped a radius inside and loses its velocity into that wall. A particle's mass is referenceMass times its
-// massRatio (ParticleSolver::massRatios; empty: all referenceMass).
+// massRatio (ParticleSolver::massRatios; empty: all referenceMass). With `push` (the transport velocity's
+// accelerations, Adami et al. 2013) the particle moves with v + pushScale push, and the stops act on v alone.
 template <int Dim>
 void driftAgainstSolids(std::vector<Vec<Dim>>& x, std::vector<Vec<Dim>>& v, float dt, float referenceMass,
-                        const std::vector<float>& massRatio, Colliders<Dim>& colliders, const TankWalls<Dim>& walls);
+                        const std::vector<float>& massRatio, Colliders<Dim>& colliders, const TankWalls<Dim>& walls,
+                        const std::vector<Vec<Dim>>* push = nullptr, float pushScale = 0);
 
 // The tank and the colliders together, as the measures see them.
 template <int Dim>

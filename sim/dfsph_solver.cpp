@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "core/parallel.h"
 
@@ -77,6 +78,8 @@ DfsphSolver<Dim>::DfsphSolver(const Scene& scene, std::shared_ptr<const Collider
   maxStep_ = s.time_step > 0 ? static_cast<float>(s.time_step)
                              : static_cast<float>(1.0 / (scene.output.fps * std::max(1, s.substeps)));
   xsphC_ = static_cast<float>(s.xsph_c);
+  backgroundPressure_ = static_cast<float>(s.background_pressure);
+  everyAxisPeriodic_ = static_cast<int>(scene.periodic.size()) == Dim;
   relaxation_ = kernel_.visit([&](const auto& kernel) { return jacobiRelaxation<Dim>(kernel, spacing_); });
 }
 
@@ -99,7 +102,18 @@ template <int Dim>
 float DfsphSolver<Dim>::stableTimeStep() {
   const float fastest = this->fastestAfterFall(maxStep_);
   const float step = fastest > 0 ? std::min(maxStep_, cfl_ * spacing_ / fastest) : maxStep_;
-  return std::min({step, this->depthStableStepNow(), this->tension_.stableStep(), this->viscosity_.stableStep()});
+  return std::min({step, this->depthStableStepNow(), this->tension_.stableStep(), this->viscosity_.stableStep(),
+                   transportStableStep()});
+}
+
+// The transport velocity's push moves a particle by dt^2 a_b a step, a_b of order p_b / (rho_0 h) where the
+// particles are uneven (h half the support): the vortex held at dt^2 p_b / rho_0 = 0.18 h^2 and blew up at 0.2 to
+// 0.36, so dt <= 0.45 h / sqrt(p_b / rho_0), the step of a sound speed sqrt(p_b / rho_0) at Courant number 0.45.
+// A shorter step (solver.time_step, substeps) weakens the push as dt^2 (docs/viscosity.md).
+template <int Dim>
+float DfsphSolver<Dim>::transportStableStep() const {
+  if (!(backgroundPressure_ > 0)) return std::numeric_limits<float>::infinity();
+  return 0.45f * (0.5f * support_) / std::sqrt(backgroundPressure_ / restDensity_);
 }
 
 template <int Dim>
@@ -122,7 +136,9 @@ long DfsphSolver<Dim>::step(float dt, double time) {
     if (!colliders_.empty()) recordColliderImpulses(densityWarm_, dt);
   }
   if (!colliders_.empty()) colliders_.beginStep(time, dt);
-  driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_);
+  if (backgroundPressure_ > 0) computeTransportAccelerations();
+  driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_,
+                     backgroundPressure_ > 0 ? &transportAcceleration_ : nullptr, dt);
 
   // The new positions' neighbours and factors, and Algorithm 2: the divergence solver on v.
   prepareStep();
@@ -173,6 +189,7 @@ void DfsphSolver<Dim>::prepareStep() {
     else computeFactors<true>(kernel);
     return 0;
   });
+  confinedTarget();
   prepared_ = true;
 }
 
@@ -229,6 +246,42 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
 }
 
 // v += dt (g + the attractor); then XSPH: v_i += c sum_j V (v_j - v_i) W_ij.
+// Adami, Hu and Adams 2013's transport velocity, as WCSPH's (sim/wcsph_solver.h): the drift moves particles with
+// v + dt a_b, a_b = -(p_b / rho_0) (sum_j (1 / r_i^2 + 1 / r_j^2) g_ij + 2 / r_i^2 G_i), r = rho / rho_0 (m_j = V
+// rho_0), from the factors of the step's start (w_i times it with several fluids, as the pressure's change).
+template <int Dim>
+void DfsphSolver<Dim>::computeTransportAccelerations() {
+  const PhaseTimer timer(times_.forces);
+  transportAcceleration_.resize(size());
+  const float scale = -backgroundPressure_ / restDensity_;
+  const float* inverse = inverseMassRatio_.empty() ? nullptr : inverseMassRatio_.data();
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const float inverseSquareI = 1.0f / (densityRatio_[i] * densityRatio_[i]);
+      VecD sum = (2.0f * inverseSquareI) * wallGradient_[i];
+      const VecD* g = pairGradients_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++g)
+        sum += (inverseSquareI + 1.0f / (densityRatio_[*j] * densityRatio_[*j])) * *g;
+      transportAcceleration_[i] = (inverse ? scale * inverse[i] : scale) * sum;
+    }
+  });
+}
+
+// The density the density solver aims at, over rho_0: 1, but in a domain periodic along every axis the mean of
+// rho_i / rho_0 when above 1. Such a fluid cannot be compressed as a whole, and a disordered set's summation
+// density averages above the lattice's (0.8% at jitter 0.2): aimed at 1, the solve ran into its iteration cap
+// every step and its lambda, a pressure over the whole box, pushed the particles about (docs/viscosity.md).
+template <int Dim>
+void DfsphSolver<Dim>::confinedTarget() {
+  if (!everyAxisPeriodic_ || size() == 0) return;
+  const double sum = parallelSum<double>(0, size(), [&](size_t b, size_t e) {
+    double local = 0;
+    for (size_t i = b; i < e; ++i) local += densityRatio_[i];
+    return local;
+  });
+  densityTarget_ = std::max(1.0f, static_cast<float>(sum / size()));
+}
+
 template <int Dim>
 void DfsphSolver<Dim>::applyNonPressureForces(float dt, double time) {
   const PhaseTimer timer(times_.forces);
@@ -261,7 +314,7 @@ float DfsphSolver<Dim>::residual(size_t i, bool density, float dt) const {
   const VecD* g = pairGradients_[i / NeighborLists::kChunk].data() + neighbors_.start(i);
   for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j, ++g) divergence += (vi - v_[*j]).dot(*g);
   if (!colliders_.empty()) divergence -= wallFlux_[i];
-  if (density) return densityRatio_[i] - 1.0f + dt * divergence;
+  if (density) return densityRatio_[i] - densityTarget_ + dt * divergence;
   return densityRatio_[i] < kSurfaceDensity ? 0.0f : dt * divergence;
 }
 

@@ -84,6 +84,11 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   template <bool kSeveral, typename Kernel>
   void computeFactors(const Kernel& kernel);
   void applyNonPressureForces(float dt, double time);
+  // densityTarget_ for the factors just computed.
+  void confinedTarget();
+  // a_b of solver.background_pressure at the step's start, and the step its push allows.
+  void computeTransportAccelerations();
+  float transportStableStep() const;
   // One of the two solvers (Algorithms 2 and 3): iterates on v_ until the average residual is at most `limit`
   // (and at least `minimum` times, at most solver.max_iterations), starting from half of `warm` where the particle
   // is compressed; `warm` ends as this solve's total. Returns the corrections applied.
@@ -102,6 +107,7 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   int maxIterations_;
   float cfl_, maxStep_, xsphC_;
   float relaxation_;  // the Jacobi relaxation omega for this kernel and spacing (jacobiRelaxation)
+  float backgroundPressure_;  // p_b of the transport velocity; 0 none
 
   // DFSPH's channels beside the core's.
   std::vector<float> densityRatio_;  // rho_i / rho_0 at the current positions
@@ -109,9 +115,12 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   std::vector<VecD> wallGradient_;   // G_i, the tank's and the colliders'
   std::vector<float> wallFlux_;      // sum_c V v_c . grad W over the colliders (moving walls); only with colliders
   std::vector<float> densityWarm_, divergenceWarm_, increments_;
+  std::vector<VecD> transportAcceleration_;  // a_b, with solver.background_pressure only
   std::vector<std::vector<VecD>> pairGradients_;  // g_ij, parallel to neighbors_
   std::vector<std::vector<float>> pairWeights_;   // W_ij for XSPH; only with xsph_c > 0
   bool prepared_ = false;  // the factors are those of the current positions
+  float densityTarget_ = 1;  // what the density solve aims rho_i / rho_0 at (confinedTarget)
+  bool everyAxisPeriodic_ = false;
 
   int densityIterations_ = 0, divergenceIterations_ = 0;
   float framePressureMax_ = 0, lastStep_ = 0;

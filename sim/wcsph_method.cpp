@@ -31,18 +31,13 @@ void declareWcsphKeys(SceneVisitor& v, SolverSettings& s) {
   v.real("near_pressure", s.near_pressure,
          atLeast(0, "WCSPH: near-pressure stiffness of Clavet et al. 2005's double density relaxation, as a "
                     "force; keeps surface particles apart; 0 turns it off", "m^2/s^2"));
-  v.real("background_pressure", s.background_pressure,
-         atLeast(0, "WCSPH: Adami, Hu and Adams 2013's transport velocity: particles move as if under this extra "
-                    "pressure, which keeps them evenly spaced, while their momentum does not feel it; for fluid "
-                    "that fills its domain (it pulls a free surface apart): about 2 rho_0 c^2; 0 turns it off "
-                    "(docs/viscosity.md)", "Pa"));
 }
 
 // The pressure only turns the energy of compression, which the fall gave, back into motion: a spacing a frame, so
 // that a scene with nothing moving (no gravity) still has a runaway speed above zero.
 int wcsphPushesPerFrame(const Scene&) { return 1; }
 
-// The transport velocity pushes particles out of a free surface: a note where the fluid does not fill the tank.
+// A jittered start is compressed, and WCSPH gives that back as motion.
 std::vector<std::string> wcsphNotes(const Scene& scene) {
   std::vector<std::string> notes;
   for (size_t i = 0; i < scene.fluids.size(); ++i)
@@ -51,14 +46,6 @@ std::vector<std::string> wcsphNotes(const Scene& scene) {
                       "energy back as motion (the energy account credits it in frame 1's source_work)");
       break;
     }
-  if (scene.solver.background_pressure <= 0) return notes;
-  double tank = 1;
-  for (int k = 0; k < scene.dimensions; ++k) tank *= scene.domain.max[k] - scene.domain.min[k];
-  const double fluid = double(scene.particleCount()) * std::pow(scene.particle_spacing, scene.dimensions);
-  if (scene.emitters.empty() && fluid >= 0.99 * tank) return notes;
-  notes.push_back("solver.background_pressure pushes the particles of a free surface out of it: it is meant for "
-                  "fluid that fills its domain (a periodic box, a closed cavity), and this fluid fills " +
-                  std::to_string(int(std::lround(100 * fluid / tank))) + "% of the tank");
   return notes;
 }
 

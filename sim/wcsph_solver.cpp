@@ -129,16 +129,8 @@ long WcsphSolver<Dim>::step(float dt, double time) {
 // v alone (the kick is added for the drift and taken back after it).
 template <int Dim>
 void WcsphSolver<Dim>::drift(float dt, float kick) {
-  const bool transport = backgroundPressure_ > 0;
-  if (transport)
-    parallelFor(0, size(), [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) v_[i] += kick * transportAcceleration_[i];
-    });
-  driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_);
-  if (transport)
-    parallelFor(0, size(), [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) v_[i] -= kick * transportAcceleration_[i];
-    });
+  driftAgainstSolids(x_, v_, dt, mass_, this->massRatio_, colliders_, walls_,
+                     backgroundPressure_ > 0 ? &transportAcceleration_ : nullptr, kick);
 }
 
 template <int Dim>
