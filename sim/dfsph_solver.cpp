@@ -245,7 +245,6 @@ void DfsphSolver<Dim>::computeFactors(const Kernel& kernel) {
   });
 }
 
-// v += dt (g + the attractor); then XSPH: v_i += c sum_j V (v_j - v_i) W_ij.
 // Adami, Hu and Adams 2013's transport velocity, as WCSPH's (sim/wcsph_solver.h): the drift moves particles with
 // v + dt a_b, a_b = -(p_b / rho_0) (sum_j (1 / r_i^2 + 1 / r_j^2) g_ij + 2 / r_i^2 G_i), r = rho / rho_0 (m_j = V
 // rho_0), from the factors of the step's start (w_i times it with several fluids, as the pressure's change).
@@ -282,6 +281,7 @@ void DfsphSolver<Dim>::confinedTarget() {
   densityTarget_ = std::max(1.0f, static_cast<float>(sum / size()));
 }
 
+// v += dt (g + the attractor); then XSPH: v_i += c sum_j V (v_j - v_i) W_ij.
 template <int Dim>
 void DfsphSolver<Dim>::applyNonPressureForces(float dt, double time) {
   const PhaseTimer timer(times_.forces);

@@ -5,7 +5,8 @@
 //   non-pressure forces       gravity, the attractor, XSPH viscosity (as PBF's eq. 17): v* = v + dt a
 //   correctDensityError       Algorithm 3: the constant-density solver on v*, until the average predicted
 //                             compression is under solver.max_density_error (at least 2 iterations)
-//   drift                     x += dt v*, stopped at the colliders and the tank
+//   drift                     x += dt v*, stopped at the colliders and the tank (with solver.background_pressure,
+//                             x += dt (v* + dt a_b): Adami et al. 2013's transport velocity, as WCSPH's)
 //   neighbours, rho, alpha    the grid sort, rho_i = sum_j m W_ij and the factor alpha_i of the new positions
 //   correctDivergenceError    Algorithm 2: the divergence-free solver on v, until the average density change a
 //                             step of compression would cause is under solver.max_divergence_error (at least 1)
@@ -16,8 +17,10 @@
 //   v_i -= (1 / dt) (sum_j (lambda_i + lambda_j) g_ij + lambda_i G_i)   (the pressure force; walls as Akinci's)
 // where s_i is the predicted compression rho*_i / rho_0 - 1, rho*_i = rho_i + dt D rho_i / Dt, for the density
 // solver, and dt times the velocity divergence D rho_i / Dt / rho_0 = sum_j (v_i - v_j) . g_ij + v_i . G_i
-// (less the walls' own motion) for the divergence solver. The solvers are Jacobi iterations, relaxed by 0.5
-// (as SPlisHSPlasH's), on the accumulated lambda, projected to lambda >= 0 (no tension). Part of each one's
+// (less the walls' own motion) for the divergence solver; in a box periodic along every axis, which cannot be
+// compressed as a whole, the density solver's 1 is the mean of rho_i / rho_0 when above 1. The solvers are Jacobi
+// iterations, relaxed by 0.5 (as SPlisHSPlasH's) or less where the kernel's many neighbours need it, on the
+// accumulated lambda, projected to lambda >= 0 (no tension). Part of each one's
 // total starts it in the next step (the 2017 paper's warm start); the totals are carried state, written beside
 // each frame (FluidSolver::carriedState), so a run resumed from a frame continues exactly.
 // The tank's clamp (a particle radius inside its walls) bounds every velocity the solvers compute, so they
@@ -28,7 +31,8 @@
 // of their own, as in the paper's implementation: it would hold splashes together.
 //
 // The step is from the CFL condition, dt = cfl particle_spacing / |v + g dt_max|max (the paper's dt <= 0.4 d / |v|
-// at cfl 0.4, d the particle diameter), at most dt_max = solver.time_step if set, else one frame / solver.substeps.
+// at cfl 0.4, d the particle diameter), at most dt_max = solver.time_step if set, else one frame / solver.substeps
+// (and the depth, surface tension, viscosity and transport velocity bounds).
 // (Not a fixed step, as time_step is for WCSPH: beyond its CFL step the linear prediction of both solvers fails,
 // and a whole frame a step left a dam break 30% compressed after 100 iterations, and gaining energy.)
 #pragma once
