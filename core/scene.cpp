@@ -11,8 +11,8 @@
 #include <set>
 #include <sstream>
 
-#include "core/expression.h"
 #include "core/errors.h"
+#include "core/expression.h"
 #include "core/scene_fields.h"
 
 namespace surge {
