@@ -288,11 +288,12 @@ void visitScene(Scene& s, SceneVisitor& v) {
              info("WCSPH and DFSPH smoothing kernel, support kernel_radius: cubic spline (Monaghan 1992) or "
                   "Wendland C2"));
     v.real("background_pressure", s.solver.background_pressure,
-           atLeast(0, "WCSPH and DFSPH: Adami, Hu and Adams 2013's transport velocity: particles move as if under "
-                      "this extra pressure, which keeps them evenly spaced, while their momentum does not feel it; "
-                      "for fluid that fills its domain (it pulls a free surface apart). WCSPH: about 2 rho_0 c^2. "
-                      "DFSPH: a push of dt^2 p_b / rho_0 a step, which bounds its step at 0.45 (kernel_radius / 2) "
-                      "/ sqrt(p_b / rho_0) (5000 for a vortex at spacing 0.02); 0 turns it off (docs/viscosity.md)",
+           atLeast(0, "Adami, Hu and Adams 2013's transport velocity: particles move as if under this extra "
+                      "pressure, which keeps them evenly spaced, while their momentum does not feel it; for fluid "
+                      "that fills its domain (it pulls a free surface apart). WCSPH: about 2 rho_0 c^2. DFSPH and "
+                      "PBF: a push of dt^2 p_b / rho_0 a step, which bounds the step at 0.45 (kernel_radius / 2) / "
+                      "sqrt(p_b / rho_0) (a vortex at spacing 0.02: 1e4 in DFSPH, 4e4 in PBF); 0 turns it off "
+                      "(docs/viscosity.md)",
                       "Pa"));
     v.real("time_step", s.solver.time_step,
            atLeast(0, "WCSPH: a fixed step; 0 chooses each step from the CFL condition and the viscous and "

@@ -2,11 +2,13 @@
 // One step is the paper's Algorithm 1, split into named phases:
 //   predictPositions        lines 1-4   apply external forces, predict x*
 //   findNeighbors           lines 5-7   sort into the grid, reorder particles, build neighbour lists
+//   pushByTransportVelocity             (opt-in, solver.background_pressure p_b; not in the paper) x* += dt^2 a_b,
+//                                       Adami et al. 2013's transport velocity, as WCSPH's and DFSPH's
 //   solveDensityConstraints lines 8-19  a warm start (below), then Jacobi iterations: lambda (eq. 11), delta p
 //                                       with s_corr (eq. 12-14), collision response, x* += delta p; the
 //                                       iterations are Chebyshev-accelerated when they run to a density
 //                                       error under a cap of 8 or more (Wang 2015, see the .cpp)
-//   updateVelocities        line 21     v = (x* - x) / dt
+//   updateVelocities        line 21     v = (x* - x) / dt (less the push's dt a_b)
 //   vorticity + XSPH        line 22     vorticity confinement (eq. 15-16), XSPH viscosity (eq. 17)
 //   commit                  line 23     x = x*
 // The warm start (solver.warm_start, not in the paper; off by default, experimental): each particle's lambdas of
@@ -88,6 +90,13 @@ class PbfSolver final : public ParticleSolver<Dim> {
   template <bool kWarmStart, bool kPeriodic>
   void applyPositionCorrectionsOf();
   void updateVelocities(float dt);
+  // p*_i += delta_i, stopped at the colliders and the tank (the position corrections, the push).
+  void moveBy(const std::vector<VecD>& delta);
+  // sim/pbf_transport.cpp: the transport velocity (solver.background_pressure) moves x* by dt^2 a_b before the
+  // constraints, a move the velocity does not keep; and the step its push allows.
+  void pushByTransportVelocity(float dt);
+  void removePushFromVelocities(float dt);
+  float transportStableStep() const;
   void collide(size_t i, const VecD& from, bool fromStepStart);
   VecD colliderCorrection(size_t i, const VecD& p, float lambda);
   void applyFriction();
@@ -110,10 +119,13 @@ class PbfSolver final : public ParticleSolver<Dim> {
   double maxDensityError_;
   int substeps_;
   float cfl_, frameStep_;  // the Courant number; a frame over the substeps
+  float backgroundPressure_;        // p_b of the transport velocity; 0 none
 
   // PBF's channels beside the core's: the predicted positions x* and the multipliers.
   std::vector<VecD> p_;
   std::vector<float> lambda_;
+  std::vector<float> densityRatio_;  // rho_i / rho_0 at x*; only with solver.background_pressure
+  std::vector<VecD> transportPush_;  // dt^2 a_b; only with solver.background_pressure
   std::vector<float> lambdaTotal_;  // the sums of each particle's lambdas this step; only with the warm start
   std::vector<VecD> omega3_;    // vorticity (3D); allocated only when vorticity confinement is on
   std::vector<float> omega2_;   // vorticity (2D, a scalar)

@@ -157,14 +157,12 @@ std::vector<std::string> solverNotes(const Scene& scene) {
   if (sceneHasAdhesion(scene) && sceneSurfaceTension(scene) == 0)
     notes.push_back("adhesion is set on a collider or body, but the fluid has no surface_tension: adhesion is a "
                     "share of the fluid's cohesion and does nothing without it");
-  // The transport velocity (WCSPH and DFSPH) pushes particles out of a free surface.
+  // The transport velocity pushes particles out of a free surface.
   if (scene.solver.background_pressure > 0) {
     double tank = 1;
     for (int k = 0; k < scene.dimensions; ++k) tank *= scene.domain.max[k] - scene.domain.min[k];
     const double fluid = double(scene.particleCount()) * std::pow(scene.particle_spacing, scene.dimensions);
-    if (scene.solver.method == "pbf")
-      notes.push_back("solver.background_pressure does nothing in PBF (WCSPH and DFSPH have the transport velocity)");
-    else if (!scene.emitters.empty() || fluid < 0.99 * tank)
+    if (!scene.emitters.empty() || fluid < 0.99 * tank)
       notes.push_back("solver.background_pressure pushes the particles of a free surface out of it: it is meant for "
                       "fluid that fills its domain (a periodic box, a closed cavity), and this fluid fills " +
                       std::to_string(int(std::lround(100 * fluid / tank))) + "% of the tank");

@@ -1,0 +1,77 @@
+// PBF's transport velocity (sim/pbf_solver.h): Adami, Hu and Adams 2013's push (solver.background_pressure), as
+// WCSPH and DFSPH have it, applied to the predicted positions before the density constraints are solved. A
+// scene without it runs no pass here.
+#include <cmath>
+#include <limits>
+
+#include "core/parallel.h"
+#include "sim/pbf_solver.h"
+
+namespace surge {
+
+// rho_i / rho_0 at the predicted positions (eq. 2 with the tank's walls), then
+//   a_b = -(p_b / rho_0) (m / rho_0) (sum_j (1 / r_i^2 + 1 / r_j^2) grad W_ij + 2 / r_i^2 G_i), r = rho / rho_0,
+// G_i the walls' gradient (w_i times it with several fluids, as eq. 12's move): x*_i += dt^2 a_b, stopped at the
+// colliders and the tank, a move the velocity of line 21 does not keep (removePushFromVelocities).
+template <int Dim>
+void PbfSolver<Dim>::pushByTransportVelocity(float dt) {
+  const PhaseTimer timer(times_.pressure);
+  densityRatio_.resize(size());
+  const float selfWeight = kernels_.poly6(0.0f);
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const VecD pi = p_[i];
+      float weight = selfWeight;
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j)
+        weight += kernels_.poly6(pairOffset(i, *j, pi).squaredNorm());
+      VecD unused = VecD::Zero();
+      walls_.add(pi, weight, unused);
+      densityRatio_[i] = mass_ * weight / restDensity_;
+    }
+  });
+  transportPush_.resize(size());
+  const float scale = -dt * dt * backgroundPressure_ / restDensity_ * massOverRho_;
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const VecD pi = p_[i];
+      const float inverseSquareI = 1.0f / (densityRatio_[i] * densityRatio_[i]);
+      float unusedWeight = 0;
+      VecD wallGradient = VecD::Zero();
+      walls_.add(pi, unusedWeight, wallGradient);
+      VecD sum = (2.0f * inverseSquareI) * wallGradient;
+      for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
+        const VecD r = pairOffset(i, *j, pi);
+        const float inverseSquareJ = 1.0f / (densityRatio_[*j] * densityRatio_[*j]);
+        sum += ((inverseSquareI + inverseSquareJ) * kernels_.pair(r.squaredNorm()).gradientFactor) * r;
+      }
+      transportPush_[i] = (inverseMassRatio_.empty() ? scale : scale * inverseMassRatio_[i]) * sum;
+    }
+  });
+  moveBy(transportPush_);
+}
+
+// v_i -= push_i / dt after line 21: the momentum does not feel p_b.
+template <int Dim>
+void PbfSolver<Dim>::removePushFromVelocities(float dt) {
+  const float inverseDt = 1.0f / dt;
+  parallelFor(0, size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) v_[i] -= inverseDt * transportPush_[i];
+  });
+}
+
+// The push is dt^2 a_b, a_b of order p_b / (rho_0 h) where the particles are uneven (h half the support): as
+// DFSPH's (sim/dfsph_solver.cpp), dt <= 0.45 h / sqrt(p_b / rho_0).
+template <int Dim>
+float PbfSolver<Dim>::transportStableStep() const {
+  if (!(backgroundPressure_ > 0)) return std::numeric_limits<float>::infinity();
+  return 0.45f * (0.5f * kernels_.radius()) / std::sqrt(backgroundPressure_ / restDensity_);
+}
+
+template void PbfSolver<2>::pushByTransportVelocity(float);
+template void PbfSolver<3>::pushByTransportVelocity(float);
+template void PbfSolver<2>::removePushFromVelocities(float);
+template void PbfSolver<3>::removePushFromVelocities(float);
+template float PbfSolver<2>::transportStableStep() const;
+template float PbfSolver<3>::transportStableStep() const;
+
+}  // namespace surge
