@@ -6,8 +6,8 @@
 # - periodic axes: a 3D pool at rest (50 x 20 x 50 particles) periodic along x and z beside the same pool between
 #   walls, ms a step, in each method;
 # - the transport velocity (solver.background_pressure): Taylor-Green's box (2D, 100 x 100 particles, periodic,
-#   a uniform flow, jittered) with p_b = 2e5 Pa (WCSPH) and 1e4 Pa (DFSPH, XSPH off) beside p_b = 0, ms a step and
-#   the forces phase a step.
+#   a uniform flow, jittered) with p_b = 2e5 Pa (WCSPH), 1e4 Pa (DFSPH, XSPH off) and 4e4 Pa (PBF, XSPH off)
+#   beside p_b = 0, ms a step and the phase the push is timed in (the forces; PBF's constraints) a step.
 #
 #   scripts/bench_viscosity.sh [SURGE_BINARY] [FRAMES] [POOL_FRAMES]   (defaults 30 and 10: WCSPH's pool takes
 #   about 5 s a frame)
@@ -53,22 +53,24 @@ cat >"$work/box.json" <<'JSON'
  "solver": {"method": "wcsph", "speed_of_sound": 10, "kernel": "wendland_c2", "kernel_radius": 0.035},
  "output": {"fps": 30, "frames": 30}}
 JSON
-echo
-echo "| Taylor-Green's box, WCSPH | ms a step | forces phase, ms a step |"
-echo "|---|---|---|"
-read -r plain plainPhase < <(best "$work/box.json" --set output.frames="$pool_frames")
-read -r pushed pushedPhase < <(best "$work/box.json" --set output.frames="$pool_frames" --set solver.background_pressure=2e5)
-awk -v a="$plain" -v b="$pushed" -v pa="$plainPhase" -v pb="$pushedPhase" 'BEGIN {
-  printf "| p_b = 0 | %.3f | %.3f |\n| p_b = 2e5 Pa | %.3f | %.3f |\n| ratio | %.3f | transport velocity %.0f%% of a step |\n",
-         a, pa, b, pb, b / a, 100 * (b - a) / b }'
-
-echo
-echo "| Taylor-Green's box, DFSPH | ms a step | forces phase, ms a step |"
-echo "|---|---|---|"
+# box_table METHOD SCENE P_B PHASE_COLUMN: the box without and with the push, ms a step and the phase the push
+# is timed in (stats.csv's column).
+box_table() {
+  local method=$1 scene=$2 pb=$3 column=$4 plain plainPhase pushed pushedPhase
+  echo
+  echo "| Taylor-Green's box, $method | ms a step | $column, ms a step |"
+  echo "|---|---|---|"
+  read -r plain plainPhase < <(fastest_of_three "$surge" "$work/run" "$column" "$scene" --set output.frames="$pool_frames")
+  read -r pushed pushedPhase < <(fastest_of_three "$surge" "$work/run" "$column" "$scene" \
+    --set output.frames="$pool_frames" --set solver.background_pressure="$pb")
+  awk -v a="$plain" -v b="$pushed" -v pa="$plainPhase" -v pb="$pushedPhase" -v p="$pb" 'BEGIN {
+    printf "| p_b = 0 | %.3f | %.3f |\n| p_b = %s Pa | %.3f | %.3f |\n| ratio | %.3f | transport velocity %.0f%% of a step |\n",
+           a, pa, p, b, pb, b / a, 100 * (b - a) / b }'
+}
+box_table WCSPH "$work/box.json" 2e5 ms_viscosity
 sed 's/"method": "wcsph", "speed_of_sound": 10,/"method": "dfsph", "xsph_c": 0,/' "$work/box.json" >"$work/box_dfsph.json"
-read -r plain plainPhase < <(best "$work/box_dfsph.json" --set output.frames="$pool_frames")
-read -r pushed pushedPhase < <(best "$work/box_dfsph.json" --set output.frames="$pool_frames" \
-  --set solver.background_pressure=1e4)
-awk -v a="$plain" -v b="$pushed" -v pa="$plainPhase" -v pb="$pushedPhase" 'BEGIN {
-  printf "| p_b = 0 | %.3f | %.3f |\n| p_b = 1e4 Pa | %.3f | %.3f |\n| ratio | %.3f | transport velocity %.0f%% of a step |\n",
-         a, pa, b, pb, b / a, 100 * (b - a) / b }'
+box_table DFSPH "$work/box_dfsph.json" 1e4 ms_viscosity
+# PBF with its own kernels at 3 spacings; its push is timed with the constraints.
+sed 's/"method": "wcsph", "speed_of_sound": 10, "kernel": "wendland_c2", "kernel_radius": 0.035/"method": "pbf", "xsph_c": 0, "kernel_radius": 0.03/' \
+  "$work/box.json" >"$work/box_pbf.json"
+box_table PBF "$work/box_pbf.json" 4e4 ms_constraint

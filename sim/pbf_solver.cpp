@@ -58,8 +58,8 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
   coincidentLength_ = 1e-4f * kernels_.radius();
   // s_corr is for spray and sheets, and a fluid that fills a box periodic along every axis has neither: there it
   // would act on every uncompressed pair of the bulk (a Taylor-Green vortex kept 0.29 of its energy to 0.64 s).
-  const bool everyAxisPeriodic = static_cast<int>(scene.periodic.size()) == Dim;
-  scorrK_ = everyAxisPeriodic ? 0.0f : static_cast<float>(s.scorr_k);
+  everyAxisPeriodic_ = static_cast<int>(scene.periodic.size()) == Dim;
+  scorrK_ = everyAxisPeriodic_ ? 0.0f : static_cast<float>(s.scorr_k);
   scorrN_ = s.scorr_n;
   const float dq = static_cast<float>(s.scorr_delta_q * s.kernel_radius);
   scorrInvWdq_ = 1.0f / kernels_.poly6(dq * dq);
@@ -108,7 +108,7 @@ long PbfSolver<Dim>::step(float dt, double time) {
   if (!colliders_.empty()) colliders_.beginStep(time, dt);
   predictPositions(dt, time);
   findNeighbors();
-  if (backgroundPressure_ > 0) pushByTransportVelocity(dt);
+  if (everyAxisPeriodic_ || backgroundPressure_ > 0) prepareFilledDomain(dt);
   solveDensityConstraints();
   updateVelocities(dt);
   if (backgroundPressure_ > 0) removePushFromVelocities(dt);
@@ -279,7 +279,7 @@ double PbfSolver<Dim>::computeLambdasOf(float omega) {
         weight += colliderWeight;
         gradientI += massOverRho_ * colliderGradient;
       }
-      const float constraint = std::max(mass_ * weight / restDensity_ - 1.0f, 0.0f);
+      const float constraint = std::max(mass_ * weight / restDensity_ - densityTarget_, 0.0f);
       float ownSquared = gradientI.squaredNorm();
       if constexpr (kSeveral) ownSquared *= inverse[i];
       const float lambda = -constraint / (gradientSquaredSum + ownSquared + epsilon_);

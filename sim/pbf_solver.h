@@ -2,8 +2,9 @@
 // One step is the paper's Algorithm 1, split into named phases:
 //   predictPositions        lines 1-4   apply external forces, predict x*
 //   findNeighbors           lines 5-7   sort into the grid, reorder particles, build neighbour lists
-//   pushByTransportVelocity             (opt-in, solver.background_pressure p_b; not in the paper) x* += dt^2 a_b,
-//                                       Adami et al. 2013's transport velocity, as WCSPH's and DFSPH's
+//   prepareFilledDomain                 (not in the paper) in a box periodic along every axis, the constraints
+//                                       aim at the mean density; with solver.background_pressure p_b,
+//                                       x* += dt^2 a_b, Adami et al. 2013's transport velocity (as DFSPH's)
 //   solveDensityConstraints lines 8-19  a warm start (below), then Jacobi iterations: lambda (eq. 11), delta p
 //                                       with s_corr (eq. 12-14), collision response, x* += delta p; the
 //                                       iterations are Chebyshev-accelerated when they run to a density
@@ -92,9 +93,10 @@ class PbfSolver final : public ParticleSolver<Dim> {
   void updateVelocities(float dt);
   // p*_i += delta_i, stopped at the colliders and the tank (the position corrections, the push).
   void moveBy(const std::vector<VecD>& delta);
-  // sim/pbf_transport.cpp: the transport velocity (solver.background_pressure) moves x* by dt^2 a_b before the
-  // constraints, a move the velocity does not keep; and the step its push allows.
-  void pushByTransportVelocity(float dt);
+  // sim/pbf_transport.cpp: before the constraints, the mean target of a box periodic along every axis
+  // (densityTarget_) and the transport velocity's push (solver.background_pressure), a move of x* the velocity
+  // does not keep (removePushFromVelocities); and the step the push allows.
+  void prepareFilledDomain(float dt);
   void removePushFromVelocities(float dt);
   float transportStableStep() const;
   void collide(size_t i, const VecD& from, bool fromStepStart);
@@ -120,11 +122,13 @@ class PbfSolver final : public ParticleSolver<Dim> {
   int substeps_;
   float cfl_, frameStep_;  // the Courant number; a frame over the substeps
   float backgroundPressure_;        // p_b of the transport velocity; 0 none
+  bool everyAxisPeriodic_ = false;  // domain.periodic names every axis
 
   // PBF's channels beside the core's: the predicted positions x* and the multipliers.
   std::vector<VecD> p_;
   std::vector<float> lambda_;
-  std::vector<float> densityRatio_;  // rho_i / rho_0 at x*; only with solver.background_pressure
+  float densityTarget_ = 1;           // C_i = rho_i / rho_0 - densityTarget_ (prepareFilledDomain)
+  std::vector<float> densityRatio_;  // rho_i / rho_0 at x*; only in prepareFilledDomain
   std::vector<VecD> transportPush_;  // dt^2 a_b; only with solver.background_pressure
   std::vector<float> lambdaTotal_;  // the sums of each particle's lambdas this step; only with the warm start
   std::vector<VecD> omega3_;    // vorticity (3D); allocated only when vorticity confinement is on

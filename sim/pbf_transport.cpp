@@ -1,6 +1,6 @@
-// PBF's transport velocity (sim/pbf_solver.h): Adami, Hu and Adams 2013's push (solver.background_pressure), as
-// WCSPH and DFSPH have it, applied to the predicted positions before the density constraints are solved. A
-// scene without it runs no pass here.
+// PBF in a fluid that fills its domain (sim/pbf_solver.h): the density target of a box periodic along every axis
+// and Adami, Hu and Adams 2013's transport velocity (solver.background_pressure), as DFSPH has them. Both act
+// before the density constraints are solved; a scene with neither runs no pass here.
 #include <cmath>
 #include <limits>
 
@@ -9,12 +9,10 @@
 
 namespace surge {
 
-// rho_i / rho_0 at the predicted positions (eq. 2 with the tank's walls), then
-//   a_b = -(p_b / rho_0) (m / rho_0) (sum_j (1 / r_i^2 + 1 / r_j^2) grad W_ij + 2 / r_i^2 G_i), r = rho / rho_0,
-// G_i the walls' gradient (w_i times it with several fluids, as eq. 12's move): x*_i += dt^2 a_b, stopped at the
-// colliders and the tank, a move the velocity of line 21 does not keep (removePushFromVelocities).
+// rho_i / rho_0 at the predicted positions (eq. 2 with the tank's walls), the mean target, and the push: x*_i +=
+// dt^2 a_b, stopped at the colliders and the tank, a move the velocity of line 21 does not keep.
 template <int Dim>
-void PbfSolver<Dim>::pushByTransportVelocity(float dt) {
+void PbfSolver<Dim>::prepareFilledDomain(float dt) {
   const PhaseTimer timer(times_.pressure);
   densityRatio_.resize(size());
   const float selfWeight = kernels_.poly6(0.0f);
@@ -29,6 +27,20 @@ void PbfSolver<Dim>::pushByTransportVelocity(float dt) {
       densityRatio_[i] = mass_ * weight / restDensity_;
     }
   });
+  if (everyAxisPeriodic_) {
+    // A fluid that fills a periodic box cannot be compressed as a whole, and a disordered set's summation density
+    // averages above the lattice's: aimed at 1, the constraints act on every particle (a Taylor-Green vortex at
+    // 2.5 spacings of support kept 0.68 of its energy to 0.64 s, against 0.85 aimed at the mean).
+    const double sum = parallelSum<double>(0, size(), [&](size_t b, size_t e) {
+      double local = 0;
+      for (size_t i = b; i < e; ++i) local += densityRatio_[i];
+      return local;
+    });
+    densityTarget_ = std::max(1.0f, static_cast<float>(sum / std::max<size_t>(1, size())));
+  }
+  if (!(backgroundPressure_ > 0)) return;
+  // a_b = -(p_b / rho_0) (m / rho_0) (sum_j (1 / r_i^2 + 1 / r_j^2) grad W_ij + 2 / r_i^2 G_i), r = rho / rho_0,
+  // G_i the walls' gradient (w_i times it with several fluids, as eq. 12's move).
   transportPush_.resize(size());
   const float scale = -dt * dt * backgroundPressure_ / restDensity_ * massOverRho_;
   parallelFor(0, size(), [&](size_t b, size_t e) {
@@ -59,16 +71,16 @@ void PbfSolver<Dim>::removePushFromVelocities(float dt) {
   });
 }
 
-// The push is dt^2 a_b, a_b of order p_b / (rho_0 h) where the particles are uneven (h half the support): as
-// DFSPH's (sim/dfsph_solver.cpp), dt <= 0.45 h / sqrt(p_b / rho_0).
+// The push moves a particle by dt^2 a_b, a_b of order p_b / (rho_0 h) where the particles are uneven (h half the
+// support): as DFSPH's (sim/dfsph_solver.cpp), dt <= 0.45 h / sqrt(p_b / rho_0).
 template <int Dim>
 float PbfSolver<Dim>::transportStableStep() const {
   if (!(backgroundPressure_ > 0)) return std::numeric_limits<float>::infinity();
   return 0.45f * (0.5f * kernels_.radius()) / std::sqrt(backgroundPressure_ / restDensity_);
 }
 
-template void PbfSolver<2>::pushByTransportVelocity(float);
-template void PbfSolver<3>::pushByTransportVelocity(float);
+template void PbfSolver<2>::prepareFilledDomain(float);
+template void PbfSolver<3>::prepareFilledDomain(float);
 template void PbfSolver<2>::removePushFromVelocities(float);
 template void PbfSolver<3>::removePushFromVelocities(float);
 template float PbfSolver<2>::transportStableStep() const;
