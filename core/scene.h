@@ -170,6 +170,7 @@ struct EmitterSettings {
   double start = 0;
   double stop = 0;  // 0: never
   std::vector<EmitterKeyframe> motion;
+  std::string fluid;  // the name of the fluid it brings (a fluids[i].name); empty: the first block's
 };
 
 struct OutputSettings {
@@ -278,12 +279,14 @@ struct Scene {
   size_t particleCount() const;
   // The fluid of block i: the index of the first block of its name (a particle frame's `fluid` property).
   size_t fluidOf(size_t block) const;
+  // The fluid emitter e brings, as fluidOf: its `fluid`'s first block, or 0.
+  size_t emittedFluid(size_t emitter) const;
   // True when the blocks name more than one fluid: the particles then carry their fluid.
   bool severalFluids() const;
   // The first block of every fluid after the first, in order (none in a scene of one fluid).
   std::vector<size_t> laterFluids() const;
   // The rest density of the particles that are not told apart: the first block's, or solver.rest_density
-  // without blocks (emitters bring fluid 0).
+  // without blocks.
   double referenceDensity() const { return fluids.empty() ? solver.rest_density : fluids.front().rest_density; }
   // True when fluid can enter or leave: emitters, sinks or open faces.
   bool hasSources() const { return !emitters.empty() || !sinks.empty() || !open.empty(); }

@@ -148,6 +148,9 @@ void visitEmitter(SceneVisitor& v, EmitterSettings& e) {
         v.real("speed", k.speed, info("speed at that time (0 closes it until a later keyframe opens it); "
                                       "negative (the default): the emitter's", "m/s"));
       });
+  v.text("fluid", e.fluid,
+         info("the name of the fluid it brings, a fluids[i].name (a block may then have neither box nor shape: it "
+              "only says what that fluid is); empty: the first block's fluid"));
 }
 
 void visitBody(SceneVisitor& v, BodySettings& b) {
@@ -192,7 +195,7 @@ void visitScene(Scene& s, SceneVisitor& v) {
          positive("initial lattice spacing; the particle radius is half of it", "m", true));
   v.list(
       "fluids", info("blocks of fluid at the start, each filled with particles on the lattice (none: the "
-                     "emitters bring it)"),
+                     "emitters bring water at solver.rest_density)"),
       [&] { return s.fluids.size(); }, [&](size_t n) { s.fluids.resize(n); },
       [&](size_t i) {
         FluidBlock& f = s.fluids[i];

@@ -96,11 +96,24 @@ void validateSolids(Scene& s, const std::string& where) {
 // it lies in the tank).
 void validateFluids(Scene& s, const std::string& where) {
   constexpr size_t kMostFluids = 255;  // a particle frame's `fluid` is a byte
+  // The fluid each emitter brings names one of the blocks' (emitters[i].fluid).
+  for (FluidBlock& fluid : s.fluids)
+    if (fluid.name.empty()) fluid.name = "water";
+  for (size_t i = 0; i < s.emitters.size(); ++i) {
+    const std::string& name = s.emitters[i].fluid;
+    if (name.empty() || std::any_of(s.fluids.begin(), s.fluids.end(), [&](const FluidBlock& f) { return f.name == name; }))
+      continue;
+    std::string known;
+    for (size_t b = 0; b < s.fluids.size(); ++b)
+      if (s.fluidOf(b) == b) known += (known.empty() ? "" : ", ") + s.fluids[b].name;
+    throw InputError(where, "emitters[" + std::to_string(i) + "].fluid",
+                     "'" + name + "' is not the name of a fluid: " +
+                         (known.empty() ? std::string("the scene has no fluids blocks") : "the scene has " + known));
+  }
   for (size_t i = 0; i < s.fluids.size(); ++i) {
     FluidBlock& fluid = s.fluids[i];
     const std::string key = "fluids[" + std::to_string(i) + "]";
     // Which fluid: a name that can end a grid's name (surface_<name>), and one density and colour a name.
-    if (fluid.name.empty()) fluid.name = "water";
     if (!std::all_of(fluid.name.begin(), fluid.name.end(), [](char c) { return std::isalnum(uint8_t(c)) || c == '_' || c == '-'; }))
       throw InputError(where, key + ".name", "'" + fluid.name + "' may hold only letters, digits, _ and -");
     if (fluid.rest_density == 0) fluid.rest_density = s.solver.rest_density;
@@ -137,6 +150,11 @@ void validateFluids(Scene& s, const std::string& where) {
       validateSolid(fluid.solid, key, "fluid" + std::to_string(i), s.dimensions, names, where);
       continue;
     }
+    // A block of neither box nor shape holds no particles: it says what the fluid an emitter brings is.
+    const bool emitted = std::any_of(s.emitters.begin(), s.emitters.end(), [&](const EmitterSettings& e) {
+      return e.fluid.empty() ? i == 0 : e.fluid == fluid.name;
+    });
+    if (emitted && b.min == Eigen::Vector3d::Zero() && b.max == Eigen::Vector3d::Zero()) continue;
     for (int k = 0; k < s.dimensions; ++k) {
       if (!(b.min[k] < b.max[k]))
         throw InputError(where, key + ".box", "min must be below max on every axis (or give a shape)");
@@ -279,7 +297,8 @@ void validateScene(Scene& s, const std::string& where) {
   const bool shaped = std::any_of(s.fluids.begin(), s.fluids.end(), [](const FluidBlock& f) { return f.shaped(); });
   if (s.fluids.empty() && s.emitters.empty())
     throw InputError(where, "fluids", "the scene has no fluid: give a fluid block or an emitter");
-  if (!s.fluids.empty() && !shaped && s.particleCount() == 0)
+  const bool boxed = std::any_of(s.fluids.begin(), s.fluids.end(), [](const FluidBlock& f) { return f.box.min != f.box.max; });
+  if (boxed && !shaped && s.particleCount() == 0)
     throw InputError(where, "fluids",
                      "the fluid boxes hold no particles at particle_spacing " + formatNumber(spacing));
   validateSources(s, where);
@@ -331,6 +350,12 @@ size_t Scene::fluidOf(size_t block) const {
   for (size_t i = 0; i < block; ++i)
     if (fluids[i].name == fluids[block].name) return i;
   return block;
+}
+
+size_t Scene::emittedFluid(size_t emitter) const {
+  for (size_t i = 0; i < fluids.size(); ++i)
+    if (fluids[i].name == emitters[emitter].fluid) return i;
+  return 0;
 }
 
 bool Scene::severalFluids() const {

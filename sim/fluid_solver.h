@@ -31,6 +31,7 @@ struct ParticleEdit {
   std::vector<Vec<Dim>> steerPosition, steerVelocity;
   std::vector<Vec<Dim>> addPosition, addVelocity;
   std::vector<uint32_t> addId;
+  std::vector<uint8_t> addFluid;  // each new particle's fluid (Scene::fluidOf; 0 in a scene of one fluid)
 
   bool empty() const { return remove.empty() && steer.empty() && addPosition.empty(); }
   void clear() {
@@ -41,6 +42,7 @@ struct ParticleEdit {
     addPosition.clear();
     addVelocity.clear();
     addId.clear();
+    addFluid.clear();
   }
 };
 

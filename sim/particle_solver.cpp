@@ -49,7 +49,7 @@ ParticleSolver<Dim>::ParticleSolver(const Scene& scene, std::shared_ptr<const Co
   }
 }
 
-// fluid_ from a frame's (fluid 0 where it has none: an emitter's particles), and massRatio_ from it.
+// fluid_ from a frame's (fluid 0 where it has none), and massRatio_ from it.
 template <int Dim>
 void ParticleSolver<Dim>::setFluids(const std::vector<uint8_t>& fluids, size_t n) {
   if (fluidMassRatio_.empty()) return;
@@ -128,7 +128,10 @@ void ParticleSolver<Dim>::editParticles(const ParticleEdit<Dim>& edit) {
   v_.insert(v_.end(), edit.addVelocity.begin(), edit.addVelocity.end());
   id_.insert(id_.end(), edit.addId.begin(), edit.addId.end());
   const size_t n = x_.size();
-  if (!fluidMassRatio_.empty()) setFluids(std::vector<uint8_t>(fluid_), n);  // an emitter's are fluid 0
+  if (!fluidMassRatio_.empty()) {
+    fluid_.insert(fluid_.end(), edit.addFluid.begin(), edit.addFluid.end());
+    setFluids(std::vector<uint8_t>(fluid_), n);
+  }
   // The carried channels step aside while the method sizes its others, then come back, new particles at 0.
   size_t channels = 0;
   forEachCarried([&](std::vector<float>& channel) {

@@ -159,10 +159,12 @@ FluidSources<Dim>::FluidSources(const Scene& scene, uint32_t firstId, double tim
   for (int axis = 0; axis < Dim; ++axis)
     for (int upper = 0; upper < 2; ++upper)
       if (scene.isOpen(axis, upper)) openFaces_ |= 1 << (2 * axis + upper);
-  for (const EmitterSettings& settings : scene.emitters) {
-    emitters_.emplace_back(settings, scene.particle_spacing, Dim);
+  for (const FluidBlock& fluid : scene.fluids) fluidMassRatio_.push_back(fluid.rest_density / scene.referenceDensity());
+  for (size_t e = 0; e < scene.emitters.size(); ++e) {
+    emitters_.emplace_back(scene.emitters[e], scene.particle_spacing, Dim);
     layers_.push_back(emitters_.back().layersBy(time));
     nextId_ += static_cast<uint32_t>(layers_.back() * emitters_.back().sitesPerLayer());
+    emittedFluid_.push_back(scene.severalFluids() ? static_cast<uint8_t>(scene.emittedFluid(e)) : 0);
   }
   for (size_t i = 0; i < scene.sinks.size(); ++i) {
     auto sink = std::make_unique<Sink>();
@@ -306,7 +308,7 @@ void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
         // Held back on its site against the water's push, m (v - U) / dt over the last step (U the velocity the
         // site gave it, as its site has now), the nozzle works on the water: that push times the way back.
         if (slot >= 0 && stepTime_ > 0)
-          heldWork_ -= solver.particleMass() / stepTime_ *
+          heldWork_ -= massOf(solver, i) / stepTime_ *
                        double((solver.velocities()[i] - heldVelocity_[size_t(slot)]).dot(at - x[i]));
         edit_.steer.push_back(static_cast<uint32_t>(i));
         edit_.steerPosition.push_back(at);
@@ -320,6 +322,7 @@ void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
   // standing above the face: its flow work, p V = m g (the depth there), goes to the ledger.
   Colliders<Dim>& colliders = solver.colliders();
   float above = NAN;
+  const double fluidRatio = fluidMassRatio_.empty() ? 1.0 : fluidMassRatio_[emittedFluid_[e]];
   for (size_t k = layers_[e]; k < due; ++k)
     for (size_t j = 0; j < sites; ++j) {
       const uint32_t id = nextId_++;
@@ -334,10 +337,11 @@ void FluidSources<Dim>::emit(size_t e, FluidSolver<Dim>& solver, double time) {
         blocked = (nearby_[q] - p).squaredNorm() < radius * radius;
       if (blocked || inSink(p)) continue;
       if (!std::isfinite(above)) above = waterAbove(c, reach, x);
-      flowWork_ += solver.particleMass() * scene_.gravity.norm() * above;
+      flowWork_ += solver.particleMass() * fluidRatio * scene_.gravity.norm() * above;
       edit_.addPosition.push_back(p);
       edit_.addVelocity.push_back(velocity);
       edit_.addId.push_back(id);
+      edit_.addFluid.push_back(emittedFluid_[e]);
     }
   layers_[e] = due;
 }
@@ -382,18 +386,26 @@ float FluidSources<Dim>::waterAbove(const VecD& c, float reach, const std::vecto
 }
 
 template <int Dim>
+double FluidSources<Dim>::massOf(const FluidSolver<Dim>& solver, size_t i) const {
+  const std::vector<float>& ratio = solver.massRatios();
+  return ratio.empty() ? solver.particleMass() : solver.particleMass() * ratio[i];
+}
+
+template <int Dim>
 double FluidSources<Dim>::editEnergy(const FluidSolver<Dim>& solver) const {
   const std::vector<VecD>&x = solver.positions(), &v = solver.velocities();
-  const double m = solver.particleMass();
   double energy = 0;
-  for (const uint32_t i : edit_.remove) energy -= potential_.energy<Dim>(x[i], v[i], m);
+  for (const uint32_t i : edit_.remove) energy -= potential_.energy<Dim>(x[i], v[i], massOf(solver, i));
   for (size_t k = 0; k < edit_.steer.size(); ++k) {
     const uint32_t i = edit_.steer[k];
+    const double m = massOf(solver, i);
     energy += potential_.energy<Dim>(edit_.steerPosition[k], edit_.steerVelocity[k], m) -
               potential_.energy<Dim>(x[i], v[i], m);
   }
-  for (size_t k = 0; k < edit_.addPosition.size(); ++k)
-    energy += potential_.energy<Dim>(edit_.addPosition[k], edit_.addVelocity[k], m);
+  for (size_t k = 0; k < edit_.addPosition.size(); ++k) {
+    const double ratio = fluidMassRatio_.empty() ? 1.0 : fluidMassRatio_[edit_.addFluid[k]];
+    energy += potential_.energy<Dim>(edit_.addPosition[k], edit_.addVelocity[k], solver.particleMass() * ratio);
+  }
   return energy + flowWork_ + heldWork_;
 }
 

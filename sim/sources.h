@@ -81,6 +81,7 @@ class FluidSources {
  private:
   void emit(size_t e, FluidSolver<Dim>& solver, double time);
   double editEnergy(const FluidSolver<Dim>& solver) const;
+  double massOf(const FluidSolver<Dim>& solver, size_t i) const;  // particle i's mass (kg)
   // How deep the water stands above c (along -gravity), in a column of `reach` around it: 0 where none does.
   float waterAbove(const VecD& c, float reach, const std::vector<VecD>& x) const;
   VecD outOfNozzle(const VecD& r, float along, float across, const VecD& d, float reach, float depth) const;
@@ -94,7 +95,9 @@ class FluidSources {
   VecD domainMin_, domainMax_;
   int openFaces_ = 0;  // bits: axis k's lower face 1 << 2k, upper 1 << (2k + 1)
   std::vector<EmitterSchedule> emitters_;
-  std::vector<size_t> layers_;  // layers each emitter has made
+  std::vector<size_t> layers_;          // layers each emitter has made
+  std::vector<uint8_t> emittedFluid_;   // the fluid each emitter brings (0 in a scene of one fluid)
+  std::vector<double> fluidMassRatio_;  // each fluid's particle mass over the solver's particleMass()
   uint32_t nextId_;
   double lastTime_, stepTime_ = 0;  // the last apply's time, and the step since the one before
   std::vector<std::unique_ptr<Sink>> sinks_;

@@ -158,6 +158,25 @@ TEST(Scene, SourcesAndShapedFluidsAreReadAndCheckedByKey) {
   EXPECT_EQ(error("/fluids", {{{"shape", "sphere"}, {"box", {{"min", {0, 0, 0}}, {"max", {1, 1, 0.5}}}}}}),
             "scene.json: fluids[0].box: give the fluid a box or a shape, not both");
   EXPECT_EQ(error("/fluids", {{{"shape", "sphere"}, {"position", {0.5, 0.5, 0.25}}, {"radius", 0.2}}}), "accepted");
+  // emitters[i].fluid names a fluid; a block of neither box nor shape says what that fluid is, and only then.
+  EXPECT_EQ(error("/emitters/0/fluid", "oil"),
+            "scene.json: emitters[0].fluid: 'oil' is not the name of a fluid: the scene has no fluids blocks");
+  nlohmann::json oil = json;
+  oil["fluids"] = {{{"name", "water"}, {"box", {{"min", {0, 0, 0}}, {"max", {1, 0.2, 0.5}}}}},
+                   {{"name", "oil"}, {"rest_density", 800}}};
+  EXPECT_EQ(error("/fluids", oil["fluids"]), "scene.json: fluids[1].box: min must be below max on every axis (or give a shape)");
+  oil["emitters"][0]["fluid"] = "oil";
+  const Scene pouring = parseScene(oil.dump(), "scene.json");
+  EXPECT_EQ(pouring.emittedFluid(0), 1u);
+  EXPECT_EQ(pouring.particleCount(), size_t(20 * 4 * 10));  // the oil block holds none
+  EXPECT_EQ(sceneToJson(parseScene(sceneToJson(pouring), "scene.json")), sceneToJson(pouring));
+  oil["emitters"][0]["fluid"] = "honey";
+  try {
+    parseScene(oil.dump(), "scene.json");
+    ADD_FAILURE() << "accepted honey";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "scene.json: emitters[0].fluid: 'honey' is not the name of a fluid: the scene has water, oil");
+  }
 
   nlohmann::json flat = json;
   flat["dimensions"] = 2;

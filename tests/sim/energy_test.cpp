@@ -109,6 +109,29 @@ TEST(Energy, AnEmitterBringsInTheEnergyOfWhatItEmits) {
   EXPECT_GE(kinetic.back(), 0.98 * work.back());
 }
 
+// Two emitters side by side, water and oil (800 kg/m^3, emitters[1].fluid): the same sites, so as many particles
+// each, and each brings its own mass's m U^2 / 2: source_work is N m (1 + 0.8) / 2 x U^2 / 2, within the 2% above.
+// Counted at water's mass, it would read 1.11 times that.
+TEST(Energy, AnEmitterOfAnotherFluidBringsInItsOwnMass) {
+  const Scene scene = parseScene(
+      R"({"name": "jets", "dimensions": 2, "domain": {"min": [0, 0], "max": [1, 0.4], "open": ["+x"]},
+          "particle_spacing": 0.01, "gravity": [0, 0],
+          "fluids": [{"name": "water"}, {"name": "oil", "rest_density": 800}],
+          "emitters": [{"position": [0.02, 0.1], "direction": [1, 0], "radius": 0.04, "speed": 1},
+                       {"position": [0.02, 0.3], "direction": [1, 0], "radius": 0.04, "speed": 1, "fluid": "oil"}],
+          "output": {"fps": 30, "frames": 15}})",
+      "jets.json");
+  const auto stats = run(scene, "energy_jets");
+  const std::vector<double>&work = stats.at("source_work"), &kinetic = stats.at("kinetic_energy");
+  const double mass = PbfSolver<2>(scene).particleMass(), particles = stats.at("particles").back();
+  const double expected = particles * mass * (1 + 0.8) / 2 * 0.5;
+  std::printf("two jets: %.0f particles, kinetic energy %.5g J/m, source_work %.5g, expected %.5g\n", particles,
+              kinetic.back(), work.back(), expected);
+  EXPECT_NEAR(work.back(), expected, 0.02 * expected);
+  EXPECT_LE(kinetic.back(), work.back());
+  EXPECT_GE(kinetic.back(), 0.98 * work.back());
+}
+
 // The attractor pushing (strength -20 m/s^2 at its centre, falling to 0 at 0.2 m) a lone particle out from 5 cm
 // off its centre does m s [d - d^2 / (2 r)] from 0.05 to 0.2 m on it, 1.125 m J/m, all of which the particle keeps:
 // source_work, the kick's own energy step by step, and the kinetic energy agree to float rounding (1e-4, over 130
