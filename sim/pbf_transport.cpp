@@ -40,7 +40,9 @@ void PbfSolver<Dim>::prepareFilledDomain(float dt) {
   }
   if (!(backgroundPressure_ > 0)) return;
   // a_b = -(p_b / rho_0) (m / rho_0) (sum_j (1 / r_i^2 + 1 / r_j^2) grad W_ij + 2 / r_i^2 G_i), r = rho / rho_0,
-  // G_i the walls' gradient (w_i times it with several fluids, as eq. 12's move).
+  // G_i the walls' gradient (w_i times it with several fluids, as eq. 12's move). The colliders' share is left out:
+  // the push is meant for fluid that fills a periodic box or a closed tank, and a particle it sends into a collider
+  // is stopped there as a correction is (moveBy).
   transportPush_.resize(size());
   const float scale = -dt * dt * backgroundPressure_ / restDensity_ * massOverRho_;
   parallelFor(0, size(), [&](size_t b, size_t e) {
