@@ -202,6 +202,25 @@ TEST(SurfaceTension, AJitteredBoxDropRoundsToWithinTwoPercentInDfsph3D) {
   }
 }
 
+// The same box in PBF 3D meets it as a viscous drop: with nu = 2e-4 m^2/s (fluids[0].viscosity, 200 times water's)
+// and from the lattice, read at 1, 1.5 and 2 s. Measured 0.79%, 1.03% and 0.78% (1.5e-4: 1.0 to 1.6%). With water's
+// viscosity PBF rounds it to 1% by 0.33 s, then the curvature term's work (not a potential's gradient) makes it
+// gain energy, and the energy check stops the run in frame 23 (docs/surface-tension.md).
+TEST(SurfaceTension, AViscousBoxDropRoundsToWithinTwoPercentInPbf3D) {
+  Scene scene = dropScene(3, "pbf", 0.012, {"fluids[0].viscosity=2e-4"});
+  scene.fluids[0].box.min = Eigen::Vector3d(-0.012, -0.006, -0.006);
+  scene.fluids[0].box.max = Eigen::Vector3d(0.012, 0.006, 0.006);
+  scene.output.frames = 60;
+  const fs::path dir = runScene(scene, "viscous_box_drop_pbf");
+  for (const int frame : {30, 45, 60}) {
+    std::vector<Vec<3>> x;
+    for (const auto& p : readParticlePly(framePath(dir, "particles", frame, "ply")).position) x.push_back(p);
+    const double value = anisotropy<3>(x);
+    std::printf("frame %d: anisotropy %.4f\n", frame, value);
+    EXPECT_LT(value, 0.02) << "frame " << frame;
+  }
+}
+
 // Surface tension keeps a run's bytes the same at any thread count, and a resumed run ends where an uninterrupted
 // one does (2D and 3D).
 TEST(SurfaceTension, SameBytesAtAnyThreadCountAndAfterAResume) {
