@@ -45,11 +45,25 @@ void declarePbfKeys(SceneVisitor& v, SolverSettings& s) {
 int pbfPushesPerFrame(const Scene& scene) { return std::max(1, scene.solver.substeps); }
 
 std::vector<std::string> pbfNotes(const Scene& scene) {
+  std::vector<std::string> notes;
   const int stable = stableSubsteps(scene);
-  if (stable <= scene.solver.substeps) return {};
-  return {"solver.substeps " + std::to_string(scene.solver.substeps) + " is below the " + std::to_string(stable) +
-          " a PBF pool this deep needs to stay at rest (dt <= 0.9 particle_spacing / sqrt(g depth)): its steps "
-          "will be shortened to them while the fluid stands that deep"};
+  if (stable > scene.solver.substeps)
+    notes.push_back("solver.substeps " + std::to_string(scene.solver.substeps) + " is below the " +
+                    std::to_string(stable) +
+                    " a PBF pool this deep needs to stay at rest (dt <= 0.9 particle_spacing / sqrt(g depth)): its "
+                    "steps will be shortened to them while the fluid stands that deep");
+  // PBF's own kernels (poly6, spiky) wider than 2.5 spacings stir a fluid at rest (docs/speed-accuracy.md).
+  const double spacings = scene.solver.kernel_radius / scene.particle_spacing;
+  if (spacings > 2.5 + 1e-9)
+    notes.push_back("solver.kernel_radius is " + formatNumber(spacings) + " spacings: PBF's kernels wider than 2.5 "
+                    "spacings stir a fluid at rest (a 2D pool at 3 keeps six times the kinetic energy it keeps at 2; "
+                    "at 3.5 it gains energy until the energy check stops it)");
+  // PBF's push keeps a flow's particles even (a Taylor-Green vortex within 2.3%), but stirs a fluid at rest.
+  if (scene.solver.background_pressure > 0)
+    notes.push_back("solver.background_pressure in PBF keeps a flow's particles even but stirs a fluid at rest: a "
+                    "periodic box at rest gains energy within a few frames and the energy check stops it "
+                    "(docs/viscosity.md)");
+  return notes;
 }
 
 }  // namespace

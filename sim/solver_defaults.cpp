@@ -162,11 +162,6 @@ std::vector<std::string> solverNotes(const Scene& scene) {
     double tank = 1;
     for (int k = 0; k < scene.dimensions; ++k) tank *= scene.domain.max[k] - scene.domain.min[k];
     const double fluid = double(scene.particleCount()) * std::pow(scene.particle_spacing, scene.dimensions);
-    // PBF's push moves a flow's particles evenly (a Taylor-Green vortex within 2.3%), but a fluid at rest it stirs.
-    if (scene.solver.method == "pbf")
-      notes.push_back("solver.background_pressure in PBF keeps a flow's particles even but stirs a fluid at rest: a "
-                      "periodic box at rest gains energy within a few frames and the energy check stops it "
-                      "(docs/viscosity.md)");
     if (!scene.emitters.empty() || fluid < 0.99 * tank)
       notes.push_back("solver.background_pressure pushes the particles of a free surface out of it: it is meant for "
                       "fluid that fills its domain (a periodic box, a closed cavity), and this fluid fills " +
