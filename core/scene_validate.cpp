@@ -101,8 +101,8 @@ void validateFluids(Scene& s, const std::string& where) {
     if (fluid.name.empty()) fluid.name = "water";
   for (size_t i = 0; i < s.emitters.size(); ++i) {
     const std::string& name = s.emitters[i].fluid;
-    if (name.empty() || std::any_of(s.fluids.begin(), s.fluids.end(), [&](const FluidBlock& f) { return f.name == name; }))
-      continue;
+    auto named = [&](const FluidBlock& f) { return f.name == name; };
+    if (name.empty() || std::any_of(s.fluids.begin(), s.fluids.end(), named)) continue;
     std::string known;
     for (size_t b = 0; b < s.fluids.size(); ++b)
       if (s.fluidOf(b) == b) known += (known.empty() ? "" : ", ") + s.fluids[b].name;
@@ -297,7 +297,8 @@ void validateScene(Scene& s, const std::string& where) {
   const bool shaped = std::any_of(s.fluids.begin(), s.fluids.end(), [](const FluidBlock& f) { return f.shaped(); });
   if (s.fluids.empty() && s.emitters.empty())
     throw InputError(where, "fluids", "the scene has no fluid: give a fluid block or an emitter");
-  const bool boxed = std::any_of(s.fluids.begin(), s.fluids.end(), [](const FluidBlock& f) { return f.box.min != f.box.max; });
+  const bool boxed =
+      std::any_of(s.fluids.begin(), s.fluids.end(), [](const FluidBlock& f) { return f.box.min != f.box.max; });
   if (boxed && !shaped && s.particleCount() == 0)
     throw InputError(where, "fluids",
                      "the fluid boxes hold no particles at particle_spacing " + formatNumber(spacing));

@@ -79,7 +79,6 @@ DfsphSolver<Dim>::DfsphSolver(const Scene& scene, std::shared_ptr<const Collider
                              : static_cast<float>(1.0 / (scene.output.fps * std::max(1, s.substeps)));
   xsphC_ = static_cast<float>(s.xsph_c);
   backgroundPressure_ = static_cast<float>(s.background_pressure);
-  everyAxisPeriodic_ = static_cast<int>(scene.periodic.size()) == Dim;
   relaxation_ = kernel_.visit([&](const auto& kernel) { return jacobiRelaxation<Dim>(kernel, spacing_); });
 }
 
@@ -103,17 +102,7 @@ float DfsphSolver<Dim>::stableTimeStep() {
   const float fastest = this->fastestAfterFall(maxStep_);
   const float step = fastest > 0 ? std::min(maxStep_, cfl_ * spacing_ / fastest) : maxStep_;
   return std::min({step, this->depthStableStepNow(), this->tension_.stableStep(), this->viscosity_.stableStep(),
-                   transportStableStep()});
-}
-
-// The transport velocity's push moves a particle by dt^2 a_b a step, a_b of order p_b / (rho_0 h) where the
-// particles are uneven (h half the support): the vortex held at dt^2 p_b / rho_0 = 0.18 h^2 and blew up at 0.2 to
-// 0.36, so dt <= 0.45 h / sqrt(p_b / rho_0), the step of a sound speed sqrt(p_b / rho_0) at Courant number 0.45.
-// A shorter step (solver.time_step, substeps) weakens the push as dt^2 (docs/viscosity.md).
-template <int Dim>
-float DfsphSolver<Dim>::transportStableStep() const {
-  if (!(backgroundPressure_ > 0)) return std::numeric_limits<float>::infinity();
-  return 0.45f * (0.5f * support_) / std::sqrt(backgroundPressure_ / restDensity_);
+                   this->transportStableStep(backgroundPressure_, support_)});
 }
 
 template <int Dim>
@@ -189,7 +178,7 @@ void DfsphSolver<Dim>::prepareStep() {
     else computeFactors<true>(kernel);
     return 0;
   });
-  confinedTarget();
+  if (this->periodic_.everyAxis() && size() > 0) densityTarget_ = this->meanDensityTarget(densityRatio_);
   prepared_ = true;
 }
 
@@ -264,21 +253,6 @@ void DfsphSolver<Dim>::computeTransportAccelerations() {
       transportAcceleration_[i] = (inverse ? scale * inverse[i] : scale) * sum;
     }
   });
-}
-
-// The density the density solver aims at, over rho_0: 1, but in a domain periodic along every axis the mean of
-// rho_i / rho_0 when above 1. Such a fluid cannot be compressed as a whole, and a disordered set's summation
-// density averages above the lattice's (0.8% at jitter 0.2): aimed at 1, the solve ran into its iteration cap
-// every step and its lambda, a pressure over the whole box, pushed the particles about (docs/viscosity.md).
-template <int Dim>
-void DfsphSolver<Dim>::confinedTarget() {
-  if (!everyAxisPeriodic_ || size() == 0) return;
-  const double sum = parallelSum<double>(0, size(), [&](size_t b, size_t e) {
-    double local = 0;
-    for (size_t i = b; i < e; ++i) local += densityRatio_[i];
-    return local;
-  });
-  densityTarget_ = std::max(1.0f, static_cast<float>(sum / size()));
 }
 
 // v += dt (g + the attractor); then XSPH: v_i += c sum_j V (v_j - v_i) W_ij.
@@ -359,7 +333,8 @@ int DfsphSolver<Dim>::solve(bool density, float dt, double limit, int minimum, s
                            double sum = 0;
                            for (size_t i = b; i < e; ++i) {
                              const float s = residual(i, density, dt);
-                             const float next = diagonal_[i] > 0 ? std::max(total[i] + relaxation_ * s / diagonal_[i], 0.0f) : 0.0f;
+                             const float next =
+                                 diagonal_[i] > 0 ? std::max(total[i] + relaxation_ * s / diagonal_[i], 0.0f) : 0.0f;
                              increments_[i] = next - total[i];
                              sum += std::max(s, 0.0f);
                            }

@@ -88,11 +88,8 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   template <bool kSeveral, typename Kernel>
   void computeFactors(const Kernel& kernel);
   void applyNonPressureForces(float dt, double time);
-  // densityTarget_ for the factors just computed.
-  void confinedTarget();
-  // a_b of solver.background_pressure at the step's start, and the step its push allows.
+  // a_b of solver.background_pressure at the step's start.
   void computeTransportAccelerations();
-  float transportStableStep() const;
   // One of the two solvers (Algorithms 2 and 3): iterates on v_ until the average residual is at most `limit`
   // (and at least `minimum` times, at most solver.max_iterations), starting from half of `warm` where the particle
   // is compressed; `warm` ends as this solve's total. Returns the corrections applied.
@@ -123,8 +120,7 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   std::vector<std::vector<VecD>> pairGradients_;  // g_ij, parallel to neighbors_
   std::vector<std::vector<float>> pairWeights_;   // W_ij for XSPH; only with xsph_c > 0
   bool prepared_ = false;  // the factors are those of the current positions
-  float densityTarget_ = 1;  // what the density solve aims rho_i / rho_0 at (confinedTarget)
-  bool everyAxisPeriodic_ = false;
+  float densityTarget_ = 1;  // what the density solve aims rho_i / rho_0 at (ParticleSolver::meanDensityTarget)
 
   int densityIterations_ = 0, divergenceIterations_ = 0;
   float framePressureMax_ = 0, lastStep_ = 0;

@@ -165,6 +165,11 @@ class ParticleSolver : public FluidSolver<Dim> {
   // sqrt(|g| depth) (infinity without gravity or particles): a dam break's column is deeper at the start than
   // the pool it settles into.
   float depthStableStepNow();
+  // The fluid-filled box's shared parts (DFSPH's and PBF's): the density target of a domain periodic along every
+  // axis, the mean of `densityRatio` (rho_i / rho_0) when above 1; and the step the transport velocity's push
+  // allows, dt <= 0.45 (support / 2) / sqrt(p_b / rho_0) (infinity without it).
+  float meanDensityTarget(const std::vector<float>& densityRatio) const;
+  float transportStableStep(float backgroundPressure, float support) const;
   // The end of a method's step: positions that crossed a periodic face move back in by a period; then the
   // first particle that is not finite, left the tank or ran away (firstParticleOutside), or -1.
   long endStep() {

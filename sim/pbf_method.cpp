@@ -29,8 +29,8 @@ void declarePbfKeys(SceneVisitor& v, SolverSettings& s) {
                     "fewer iterations for the same density error, up to where it overshoots (0.95 blows a dam "
                     "break up; docs/speed-accuracy.md); 0 turns it off", "", 0.95));
   v.real("scorr_k", s.scorr_k,
-         atLeast(0, "PBF eq. 13 artificial pressure k, in units of the rest lattice's lambda; 0 turns s_corr off (as a domain "
-                    "periodic along every axis does: no spray or sheets there)"));
+         atLeast(0, "PBF eq. 13 artificial pressure k, in units of the rest lattice's lambda; 0 turns s_corr off (as "
+                    "a domain periodic along every axis does: no spray or sheets there)"));
   v.integer("scorr_n", s.scorr_n, atLeast(1, "PBF eq. 13 exponent n", "", 16));
   {
     FieldInfo dq = positive("PBF eq. 13 delta q, as a fraction of the kernel radius (paper: 0.1 to 0.3)");

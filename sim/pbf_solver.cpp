@@ -58,8 +58,7 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
   coincidentLength_ = 1e-4f * kernels_.radius();
   // s_corr is for spray and sheets, and a fluid that fills a box periodic along every axis has neither: there it
   // would act on every uncompressed pair of the bulk (a Taylor-Green vortex kept 0.29 of its energy to 0.64 s).
-  everyAxisPeriodic_ = static_cast<int>(scene.periodic.size()) == Dim;
-  scorrK_ = everyAxisPeriodic_ ? 0.0f : static_cast<float>(s.scorr_k);
+  scorrK_ = this->periodic_.everyAxis() ? 0.0f : static_cast<float>(s.scorr_k);
   scorrN_ = s.scorr_n;
   const float dq = static_cast<float>(s.scorr_delta_q * s.kernel_radius);
   scorrInvWdq_ = 1.0f / kernels_.poly6(dq * dq);
@@ -85,7 +84,8 @@ template <int Dim>
 float PbfSolver<Dim>::stableTimeStep() {
   const float fastest = this->fastestAfterFall(frameStep_);
   const float dt = std::min(fastest > 0 ? cfl_ * kernels_.radius() / fastest : INFINITY, this->depthStableStepNow());
-  return std::min({dt, this->tension_.stableStep(), this->viscosity_.stableStep(), transportStableStep()});
+  return std::min({dt, this->tension_.stableStep(), this->viscosity_.stableStep(),
+                   this->transportStableStep(backgroundPressure_, kernels_.radius())});
 }
 
 template <int Dim>
@@ -108,7 +108,7 @@ long PbfSolver<Dim>::step(float dt, double time) {
   if (!colliders_.empty()) colliders_.beginStep(time, dt);
   predictPositions(dt, time);
   findNeighbors();
-  if (everyAxisPeriodic_ || backgroundPressure_ > 0) prepareFilledDomain(dt);
+  if (this->periodic_.everyAxis() || backgroundPressure_ > 0) prepareFilledDomain(dt);
   solveDensityConstraints();
   updateVelocities(dt);
   if (backgroundPressure_ > 0) removePushFromVelocities(dt);
@@ -423,8 +423,10 @@ FluidMeasures PbfSolver<Dim>::measure() {
 
 template <int Dim>
 size_t PbfSolver<Dim>::memoryBytes() const {
-  size_t bytes = (p_.capacity() + omega3_.capacity() + onlyGradient_.capacity() + transportPush_.capacity()) * sizeof(VecD);
-  bytes += (lambda_.capacity() + lambdaTotal_.capacity() + omega2_.capacity() + densityRatio_.capacity()) * sizeof(float);
+  size_t bytes = (p_.capacity() + omega3_.capacity() + onlyGradient_.capacity() + transportPush_.capacity()) *
+                 sizeof(VecD);
+  bytes += (lambda_.capacity() + lambdaTotal_.capacity() + omega2_.capacity() + densityRatio_.capacity()) *
+           sizeof(float);
   for (const auto& factors : pairGradientFactors_) bytes += factors.capacity() * sizeof(float);
   bytes += (found_.capacity() + scratchFound_.capacity()) * sizeof(typename Colliders<Dim>::Found);
   return bytes + this->coreMemoryBytes();

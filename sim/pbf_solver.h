@@ -95,10 +95,9 @@ class PbfSolver final : public ParticleSolver<Dim> {
   void moveBy(const std::vector<VecD>& delta);
   // sim/pbf_transport.cpp: before the constraints, the mean target of a box periodic along every axis
   // (densityTarget_) and the transport velocity's push (solver.background_pressure), a move of x* the velocity
-  // does not keep (removePushFromVelocities); and the step the push allows.
+  // does not keep (removePushFromVelocities).
   void prepareFilledDomain(float dt);
   void removePushFromVelocities(float dt);
-  float transportStableStep() const;
   void collide(size_t i, const VecD& from, bool fromStepStart);
   VecD colliderCorrection(size_t i, const VecD& p, float lambda);
   void applyFriction();
@@ -121,8 +120,7 @@ class PbfSolver final : public ParticleSolver<Dim> {
   double maxDensityError_;
   int substeps_;
   float cfl_, frameStep_;  // the Courant number; a frame over the substeps
-  float backgroundPressure_;        // p_b of the transport velocity; 0 none
-  bool everyAxisPeriodic_ = false;  // domain.periodic names every axis
+  float backgroundPressure_;  // p_b of the transport velocity; 0 none
 
   // PBF's channels beside the core's: the predicted positions x* and the multipliers.
   std::vector<VecD> p_;

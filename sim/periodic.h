@@ -43,6 +43,7 @@ class PeriodicDomain {
   }
 
   bool active() const { return axes_ != 0; }
+  bool everyAxis() const { return axes_ == (1 << Dim) - 1; }  // a box with no wall at all
   bool periodic(int k) const { return axes_ >> k & 1; }
   float period(int k) const { return period_[k]; }
   float min(int k) const { return min_[k]; }

@@ -73,7 +73,9 @@ TEST(SolverDefaults, EachMethodsRegistrationResolvesItsOwnDefaults) {
       solverNotes(parseScene(kValid, "s", {"solver.method=pbf", "solver.substeps=5", "solver.kernel_radius=0.15"}));
   ASSERT_EQ(wide.size(), 1u);
   EXPECT_NE(wide[0].find("solver.kernel_radius is 3 spacings"), std::string::npos) << wide[0];
-  EXPECT_TRUE(solverNotes(parseScene(kValid, "s", {"solver.method=pbf", "solver.substeps=5", "solver.kernel_radius=0.125"})).empty());
+  EXPECT_TRUE(
+      solverNotes(parseScene(kValid, "s", {"solver.method=pbf", "solver.substeps=5", "solver.kernel_radius=0.125"}))
+          .empty());
   EXPECT_TRUE(solverNotes(parseScene(kValid, "s", {"solver.method=dfsph", "solver.kernel_radius=0.15"})).empty());
   // solver.background_pressure, in every method: a note that this fluid, 20% of its tank, has a free surface the
   // push pulls apart, none where the fluid fills the tank; in PBF also one that the push stirs a fluid at rest.

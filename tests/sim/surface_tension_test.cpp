@@ -157,13 +157,31 @@ TEST(SurfaceTension, AThreeDimensionalDropOscillatesAtRayleighsFrequencyInPbf) {
   EXPECT_NEAR(crossings[0] / (M_PI / omega), 1.0, 0.1);
 }
 
+// The 2:1:1 box of water (24 x 12 x 12 particles at 1 mm) in zero gravity, in `method`.
+Scene boxDropScene(const std::string& method, const std::vector<std::string>& extra = {}) {
+  Scene scene = dropScene(3, method, 0.012, extra);
+  scene.fluids[0].box.min = Eigen::Vector3d(-0.012, -0.006, -0.006);
+  scene.fluids[0].box.max = Eigen::Vector3d(0.012, 0.006, 0.006);
+  return scene;
+}
+
+// Runs `scene` to its last frame and expects the anisotropy under the 2% at each of `frames`.
+void expectRoundWithinTwoPercent(const Scene& scene, const std::string& name, const std::vector<int>& frames) {
+  const fs::path dir = runScene(scene, name);
+  for (const int frame : frames) {
+    std::vector<Vec<3>> x;
+    for (const auto& p : readParticlePly(framePath(dir, "particles", frame, "ply")).position) x.push_back(p);
+    const double value = anisotropy<3>(x);
+    std::printf("frame %d: anisotropy %.4f\n", frame, value);
+    EXPECT_LT(value, 0.02) << "frame " << frame;
+  }
+}
+
 // A 2:1:1 box of water (24 x 12 x 12 particles) in zero gravity pulls itself round in DFSPH: its second moment's
 // anisotropy falls from 0.60 to a few per cent within 1 s, about 7 capillary times sqrt(rho R^3 / sigma); the
 // energy it releases is credited to the account up to sigma times its surface, and the run passes the energy stop.
 TEST(SurfaceTension, ABoxDropRoundsAndItsEnergyIsAccounted) {
-  Scene scene = dropScene(3, "dfsph", 0.012);
-  scene.fluids[0].box.min = Eigen::Vector3d(-0.012, -0.006, -0.006);
-  scene.fluids[0].box.max = Eigen::Vector3d(0.012, 0.006, 0.006);
+  Scene scene = boxDropScene("dfsph");
   scene.output.frames = 30;
   const fs::path dir = runScene(scene, "box_drop");
   const ParticleFrame first = readParticlePly(framePath(dir, "particles", 0, "ply"));
@@ -187,19 +205,10 @@ TEST(SurfaceTension, ABoxDropRoundsAndItsEnergyIsAccounted) {
 // 0.2 (fluids[i].jitter), read at 1 and 1.5 s. From the lattice it keeps a set of 2.4 to 3.2%; jittered, measured
 // 1.4% and 1.3% (docs/surface-tension.md has the other methods and 2D, which do not meet it).
 TEST(SurfaceTension, AJitteredBoxDropRoundsToWithinTwoPercentInDfsph3D) {
-  Scene scene = dropScene(3, "dfsph", 0.012);
-  scene.fluids[0].box.min = Eigen::Vector3d(-0.012, -0.006, -0.006);
-  scene.fluids[0].box.max = Eigen::Vector3d(0.012, 0.006, 0.006);
+  Scene scene = boxDropScene("dfsph");
   scene.fluids[0].jitter = 0.2;
   scene.output.frames = 45;
-  const fs::path dir = runScene(scene, "jittered_box_drop");
-  for (const int frame : {30, 45}) {
-    std::vector<Vec<3>> x;
-    for (const auto& p : readParticlePly(framePath(dir, "particles", frame, "ply")).position) x.push_back(p);
-    const double value = anisotropy<3>(x);
-    std::printf("frame %d: anisotropy %.4f\n", frame, value);
-    EXPECT_LT(value, 0.02) << "frame " << frame;
-  }
+  expectRoundWithinTwoPercent(scene, "jittered_box_drop", {30, 45});
 }
 
 // The same box in PBF 3D meets it as a viscous drop: with nu = 2e-4 m^2/s (fluids[0].viscosity, 200 times water's)
@@ -207,18 +216,9 @@ TEST(SurfaceTension, AJitteredBoxDropRoundsToWithinTwoPercentInDfsph3D) {
 // viscosity PBF rounds it to 1% by 0.33 s, then the curvature term's work (not a potential's gradient) makes it
 // gain energy, and the energy check stops the run in frame 23 (docs/surface-tension.md).
 TEST(SurfaceTension, AViscousBoxDropRoundsToWithinTwoPercentInPbf3D) {
-  Scene scene = dropScene(3, "pbf", 0.012, {"fluids[0].viscosity=2e-4"});
-  scene.fluids[0].box.min = Eigen::Vector3d(-0.012, -0.006, -0.006);
-  scene.fluids[0].box.max = Eigen::Vector3d(0.012, 0.006, 0.006);
+  Scene scene = boxDropScene("pbf", {"fluids[0].viscosity=2e-4"});
   scene.output.frames = 60;
-  const fs::path dir = runScene(scene, "viscous_box_drop_pbf");
-  for (const int frame : {30, 45, 60}) {
-    std::vector<Vec<3>> x;
-    for (const auto& p : readParticlePly(framePath(dir, "particles", frame, "ply")).position) x.push_back(p);
-    const double value = anisotropy<3>(x);
-    std::printf("frame %d: anisotropy %.4f\n", frame, value);
-    EXPECT_LT(value, 0.02) << "frame " << frame;
-  }
+  expectRoundWithinTwoPercent(scene, "viscous_box_drop_pbf", {30, 45, 60});
 }
 
 // Surface tension keeps a run's bytes the same at any thread count, and a resumed run ends where an uninterrupted
