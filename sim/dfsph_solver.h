@@ -90,10 +90,12 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   void applyNonPressureForces(float dt, double time);
   // a_b of solver.background_pressure at the step's start.
   void computeTransportAccelerations();
+  // A share of last step's total (kDensityWarmStart, kDivergenceWarmStart) applied to v, the solve's start.
+  void warmStart(bool density, float dt, std::vector<float>& total);
   // One of the two solvers (Algorithms 2 and 3): iterates on v_ until the average residual is at most `limit`
-  // (and at least `minimum` times, at most solver.max_iterations), starting from half of `warm` where the particle
-  // is compressed; `warm` ends as this solve's total. Returns the corrections applied.
-  int solve(bool density, float dt, double limit, int minimum, std::vector<float>& warm);
+  // (and at least `minimum` times, at most solver.max_iterations), from the warm start (applied here unless
+  // `warmed`); `total` ends as this solve's total. Returns the corrections applied.
+  int solve(bool density, float dt, double limit, int minimum, std::vector<float>& total, bool warmed = false);
   // s_i of the solver at the current velocities (the compression if density, else dt D rho / Dt / rho_0).
   float residual(size_t i, bool density, float dt) const;
   // v_i -= (1 / dt) (sum_j (d_i + d_j) g_ij + d_i G_i) for the lambda increments d, and total_i += d_i.
@@ -107,6 +109,7 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   double maxDensityError_, maxDivergenceError_;
   int maxIterations_;
   float cfl_, maxStep_, xsphC_;
+  bool pressureBeforeViscosity_ = false;  // with viscosity: the density warm start goes before its solve
   float relaxation_;  // the Jacobi relaxation omega for this kernel and spacing (jacobiRelaxation)
   float backgroundPressure_;  // p_b of the transport velocity; 0 none
 

@@ -17,29 +17,6 @@
 namespace surge {
 namespace {
 
-// The mean fy of colliders.csv's rows for collider 0 over frames [first, last].
-double meanLift(const fs::path& dir, int first, int last) {
-  std::ifstream in(dir / "colliders.csv");
-  std::string line;
-  std::getline(in, line);
-  double sum = 0;
-  int rows = 0;
-  while (std::getline(in, line)) {
-    std::stringstream cells(line);
-    std::string frame, collider, fx, fy;
-    std::getline(cells, frame, ',');
-    std::getline(cells, collider, ',');
-    std::getline(cells, fx, ',');
-    std::getline(cells, fy, ',');
-    const int f = std::stoi(frame);
-    if (f < first || f > last) continue;
-    sum += std::stod(fy);
-    ++rows;
-  }
-  EXPECT_EQ(rows, last - first + 1);
-  return rows ? sum / rows : 0;
-}
-
 // The mean height of the particles of fluid `fluid` in a frame.
 double meanHeight(const ParticleFrame& frame, uint8_t fluid) {
   double sum = 0;
@@ -73,7 +50,7 @@ TEST_P(SeveralFluidsByMethod, TwoLayersAtRestWeighOnTheFloorAsTheirDensitiesSay)
   EXPECT_EQ(std::count(first.fluid.begin(), first.fluid.end(), 0), 300);
   EXPECT_EQ(std::count(first.fluid.begin(), first.fluid.end(), 1), 150);
   const double weight = 9.81 * (1000 * 0.2 + 800 * 0.1) * 0.6;
-  const double lift = -meanLift(dir, 31, 60);  // the fluid pushes the plane down
+  const double lift = -meanColliderFy(dir, 31, 60);  // the fluid pushes the plane down
   std::printf("%s, two layers: the floor carries %.1f N/m, their weight %.1f N/m\n", method.c_str(), lift, weight);
   EXPECT_NEAR(lift, weight, 0.02 * weight);
   const ParticleFrame last = readParticlePly(dir / "particles" / "frame_00060.ply");
