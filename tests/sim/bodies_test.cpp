@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -16,6 +17,7 @@
 #include "sim/pbf_solver.h"
 #include "sim/rigid_bodies.h"
 #include "sim/simulation.h"
+#include "tests/sim/stokes_references.h"
 
 namespace surge {
 namespace {
@@ -356,6 +358,34 @@ TEST(Bodies, MomentumIsExchangedWithTheFluid) {
 // solids were placed from the step's own time and poses (Colliders::placeAtStepStart), WCSPH's first
 // accelerations of a resumed frame and DFSPH's first density solve met the solids where they stood at time 0:
 // the resumed WCSPH run gained 18 J/m from nowhere and stopped, and DFSPH's box moved otherwise.
+// Stokes settling in 2D: a steel disc (7800 kg/m^3, radius a = 0.05, 4 spacings) sinking down the middle of a
+// channel 2 l = 0.5 wide and 1.2 tall full of a fluid of nu = 0.37 reaches the speed at which Faxen's drag for a
+// cylinder between two walls carries its weight less buoyancy, U = (rho_s - rho) g pi a^2 / (F / U) = 0.0856
+// m/s (Re = U a / nu = 0.012; the channel's walls are Faxen's, so his formula is the wall correction). The mean
+// speed from its positions over frames 8 to 32 (0.2 to 0.8 s; it reaches its speed within rho_s pi a^2 / (F / U)
+// = 0.01 s and moves 5 cm, 0.4 m from the channel's top and 0.7 from its floor). DFSPH at steps of 2, 1 and
+// 0.5 ms (nu dt / a^2 = 0.30 to 0.074), each within the 10% the issue asks: 1.053, 0.962 and 0.915 of it. At
+// 0.25 ms 0.910: with a = 4 spacings the converged speed is about 9% slow (0.950 at 0.5 ms with a = 8). Before
+// the viscosity solve saw the pressure, 1.231 at 1 ms (the test then fails) and 1.46 at DFSPH's own step.
+TEST(Bodies, ADiscSettlesBetweenWallsAtFaxensSpeedInDfsph) {
+  const std::string json = R"({"name": "settle", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.5, 1.2]},
+    "particle_spacing": 0.0125, "gravity": [0, -9.81], "solver": {"method": "dfsph"},
+    "fluids": [{"box": {"min": [0, 0], "max": [0.5, 1.2]}, "viscosity": 0.37}], "output": {"fps": 40, "frames": 32},
+    "bodies": [{"name": "disc", "shape": "sphere", "position": [0.25, 0.8], "radius": 0.05, "density": 7800}]})";
+  const double a = 0.05, weight = (7800 - 1000) * 9.81 * M_PI * a * a;
+  const double faxen = weight / faxenDragPerSpeed(1000 * 0.37, a, 0.25);
+  for (const std::string step : {"0.002", "0.001", "0.0005"}) {
+    Scene scene = parseScene(json, "test", {"solver.time_step=" + step});
+    scene.name = "settle_" + step;
+    const std::vector<BodyRow> rows = readBodies(runScene(scene), "disc");
+    ASSERT_EQ(rows.size(), 33u) << step;
+    const double speed = (rows[8].position.y() - rows[32].position.y()) / (24 / 40.0);
+    std::printf("disc settling through honey (DFSPH, %s s steps): %.4f m/s, Faxen %.4f (%.3f)\n", step.c_str(),
+                speed, faxen, speed / faxen);
+    EXPECT_NEAR(speed / faxen, 1.0, 0.10) << step;
+  }
+}
+
 TEST(Bodies, AResumedRunEndsWhereTheUninterruptedOneDoesInEveryMethod) {
   for (const std::string method : {"pbf", "dfsph", "wcsph"}) {
     SCOPED_TRACE(method);

@@ -17,6 +17,7 @@
 #include "sim/simulation.h"
 #include "tests/sim/run_scene.h"
 #include "tests/sim/stats_columns.h"
+#include "tests/sim/stokes_references.h"
 
 namespace surge {
 namespace {
@@ -145,9 +146,7 @@ TEST(Viscosity, ADiscDraggedThroughHoneyBetweenWallsFeelsFaxensDragInDfsph) {
     "fluids": [{"box": {"min": [0, 0], "max": [0.5, 2.0]}, "viscosity": 0.37}], "output": {"fps": 40, "frames": 32},
     "colliders": [{"name": "disc", "shape": "sphere", "position": [0.25, 1.0], "radius": 0.05,
       "motion": [{"time": 0, "position": [0.25, 1.0]}, {"time": 1, "position": [0.25, 0.9]}]}]})";
-  const double a = 0.05, l = 0.25, ratio = a / l, mu = 1000 * 0.37, speed = 0.1;
-  const double faxen = 4 * M_PI * mu * speed /
-                       (std::log(l / a) - 0.9157 + 1.7244 * std::pow(ratio, 2) - 1.7302 * std::pow(ratio, 4));
+  const double faxen = faxenDragPerSpeed(1000 * 0.37, 0.05, 0.25) * 0.1;
   const double drag = meanColliderFy(runScene(parseScene(json, "test", {"solver.time_step=0.001"}), "faxen"), 8, 32);
   const double own = meanColliderFy(runScene(parseScene(json, "test"), "faxen_own_step"), 8, 32);
   std::printf("disc dragged through honey (DFSPH): %.0f N/m at 1 ms steps, %.0f at its own, Faxen %.0f\n", drag, own,
