@@ -280,8 +280,6 @@ static void validatePeriodic(const Scene& s, const std::string& where) {
                            formatNumber(3 * s.solver.kernel_radius) + " m) to wrap");
   }
   // The whitewater stage's neighbour search and tank do not wrap yet (docs/viscosity.md, left to do).
-  if (!s.periodic.empty() && s.whitewater.enabled)
-    throw InputError(where, "whitewater.enabled", "is not available with domain.periodic yet");
 }
 
 void validateScene(Scene& s, const std::string& where) {

@@ -78,15 +78,21 @@ class PeriodicDomain {
     if (axes_ == 0) return;
     parallelFor(0, key.size(), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
-        const VecD shift = shiftInto(key[i]);
-        if (shift.isZero()) continue;
-        key[i] += shift;
-        // Rounding can leave x + period at the upper end of the domain: the lower end is the same place.
-        for (int k = 0; k < Dim; ++k)
-          if (periodic(k) && !(key[i][k] < min_[k] + period_[k])) key[i][k] = min_[k];
-        if (also) (*also)[i] += shift;
+        const VecD shift = wrapPoint(key[i]);
+        if (also && !shift.isZero()) (*also)[i] += shift;
       }
     });
+  }
+
+  // Moves one position back into the domain; returns the shift it took.
+  VecD wrapPoint(VecD& p) const {
+    const VecD shift = shiftInto(p);
+    if (shift.isZero()) return shift;
+    p += shift;
+    // Rounding can leave x + period at the upper end of the domain: the lower end is the same place.
+    for (int k = 0; k < Dim; ++k)
+      if (periodic(k) && !(p[k] < min_[k] + period_[k])) p[k] = min_[k];
+    return shift;
   }
 
  private:

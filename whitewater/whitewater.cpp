@@ -66,6 +66,39 @@ WhitewaterStepper::WhitewaterStepper(const Scene& scene)
   tankMax_ = scene.domain.max.cast<float>();
   if (scene.dimensions == 2) gravity_.z() = tankMin_.z() = tankMax_.z() = 0;
   for (size_t c = 0; c < scene.colliders.size(); ++c) colliders_.push_back(buildColliderShape(scene, c));
+  periodic_ = PeriodicDomain<3>(scene);
+}
+
+void WhitewaterStepper::appendImages(std::vector<Eigen::Vector3f>& x, std::vector<Eigen::Vector3f>& v) const {
+  if (!periodic_.active()) return;
+  // Two radii: an image's own surface normal (eq. 4's n_j) is then whole wherever it is a neighbour. The domain
+  // is at least three radii long on a periodic axis (core/scene_validate.cpp), so each particle has one image.
+  const float band = 2 * h_;
+  const size_t n = x.size();
+  for (size_t i = 0; i < n; ++i) {
+    int side[3] = {0, 0, 0};  // +1: near the lower face, its image a period up; -1: near the upper face
+    bool near = false;
+    for (int k = 0; k < 3; ++k) {
+      if (!periodic_.periodic(k)) continue;
+      if (x[i][k] < periodic_.min(k) + band) side[k] = 1;
+      else if (x[i][k] > periodic_.min(k) + periodic_.period(k) - band) side[k] = -1;
+      near = near || side[k] != 0;
+    }
+    if (!near) continue;
+    // Every combination of the axes it is near (one image by a face, three by an edge, seven by a corner).
+    for (int mask = 1; mask < 8; ++mask) {
+      Eigen::Vector3f image = x[i];
+      bool valid = true;
+      for (int k = 0; k < 3 && valid; ++k)
+        if (mask >> k & 1) {
+          valid = side[k] != 0;
+          image[k] += float(side[k]) * periodic_.period(k);
+        }
+      if (!valid) continue;
+      x.push_back(image);
+      v.push_back(v[i]);
+    }
+  }
 }
 
 bool WhitewaterStepper::meetColliders(Eigen::Vector3f& p, Eigen::Vector3f& v, bool spray,
@@ -147,13 +180,20 @@ WhitewaterStepper::FluidSample WhitewaterStepper::sampleFluid(const Eigen::Vecto
 
 WhitewaterStepper::Potentials WhitewaterStepper::potentials(const ParticleFrame& a) {
   const size_t n = a.size();
-  sortFluid(a.position, a.velocity);
+  if (periodic_.active()) {
+    std::vector<Eigen::Vector3f> x = a.position, v = a.velocity;
+    appendImages(x, v);
+    sortFluid(x, v);
+  } else {
+    sortFluid(a.position, a.velocity);
+  }
+  const size_t all = sortedX_.size();  // the fluid and its images
   grid_.findNeighbors(sortedX_, h_, lists_);
   const std::vector<uint32_t>& order = grid_.sortedOrder();
   const float h = h_, S = restSum_;
   // Section 4.2: the surface normal from the colour gradient, where there is a surface (in the grid's order).
-  std::vector<Eigen::Vector3f> normal(n, Eigen::Vector3f::Zero());
-  parallelFor(0, n, [&](size_t b, size_t e) {
+  std::vector<Eigen::Vector3f> normal(all, Eigen::Vector3f::Zero());
+  parallelFor(0, all, [&](size_t b, size_t e) {
     for (size_t k = b; k < e; ++k) {
       const Eigen::Vector3f xk = sortedX_[k];
       Eigen::Vector3f gradient = Eigen::Vector3f::Zero();
@@ -172,9 +212,10 @@ WhitewaterStepper::Potentials WhitewaterStepper::potentials(const ParticleFrame&
   p.generated.assign(n, 0);
   const WhitewaterSettings& w = settings_;
   const double U = speed_, perFrame = frameTime_ / timeScale_;
-  parallelFor(0, n, [&](size_t b, size_t e) {
+  parallelFor(0, all, [&](size_t b, size_t e) {
     for (size_t k = b; k < e; ++k) {
       const size_t i = order[k];  // the potentials are kept in a's order
+      if (i >= n) continue;        // an image
       const Eigen::Vector3f xk = sortedX_[k], vk = sortedV_[k], nk = normal[k];
       // Section 4.3, eq. 8: the kinetic energy per unit mass, against U's.
       p.kinetic[i] = clampPotential(double(vk.squaredNorm()) / (U * U), w.kinetic_min, w.kinetic_max);
@@ -223,6 +264,11 @@ void WhitewaterStepper::advance(const ParticleFrame& a, const ParticleFrame& b, 
   for (size_t i = 0; i < n; ++i) {
     const int64_t k = a.id[i] < inB.size() ? inB[a.id[i]] : -1;
     xb[i] = k >= 0 ? b.position[size_t(k)] : Eigen::Vector3f(a.position[i] + frameTime_ * a.velocity[i]);
+    if (periodic_.active()) {  // across the seam: the nearest image of its move, so it sweeps the short way
+      Eigen::Vector3f move = xb[i] - a.position[i];
+      periodic_(move);
+      xb[i] = a.position[i] + move;
+    }
     vb[i] = k >= 0 ? b.velocity[size_t(k)] : a.velocity[i];
     fastest = std::max({fastest, a.velocity[i].norm(), vb[i].norm()});
   }
@@ -268,6 +314,7 @@ void WhitewaterStepper::advance(const ParticleFrame& a, const ParticleFrame& b, 
         }
         const size_t at = old + k;
         diffuse.position[at] = xp + offset + u(3) * speed * dt * along;
+        periodic_.wrapPoint(diffuse.position[at]);
         diffuse.velocity[at] = vp;
         diffuse.id[at] = diffuse.nextId + uint32_t(k);
         diffuse.type[at] = kFoam;  // classified as it takes its first substep
@@ -288,9 +335,13 @@ void WhitewaterStepper::advance(const ParticleFrame& a, const ParticleFrame& b, 
     const float t = (float(step) + 0.5f) / float(substeps);
     for (size_t c = 0; c < colliders_.size(); ++c)
       poses[c] = colliderPose(scene_.colliders[c], (double(frame) + double(step + 1) / substeps) * frameTime_);
+    xm.resize(n);
+    vm.resize(n);
     parallelFor(0, n, [&](size_t b0, size_t e0) {
       for (size_t i = b0; i < e0; ++i) xm[i] = lerp(a.position[i], xb[i], t), vm[i] = lerp(a.velocity[i], vb[i], t);
     });
+    periodic_.wrap(xm);
+    appendImages(xm, vm);
     sortFluid(xm, vm);
     parallelFor(0, diffuse.size(), [&](size_t b0, size_t e0) {
       for (size_t k = b0; k < e0; ++k) {
@@ -318,9 +369,11 @@ void WhitewaterStepper::advance(const ParticleFrame& a, const ParticleFrame& b, 
           diffuse.lifetime[k] -= dt;
           if (diffuse.lifetime[k] <= 0) dead[k] = 1;
         }
-        // The tank: spray breaks on a wall; foam and bubbles stay in; an open face lets anything out.
+        // The tank: spray breaks on a wall; foam and bubbles stay in; an open face lets anything out; a periodic
+        // axis brings anything round to the other side.
+        periodic_.wrapPoint(x);
         for (int axis = 0; axis < dims; ++axis)
-          for (int upper = 0; upper < 2; ++upper) {
+          for (int upper = 0; upper < 2 && !periodic_.periodic(axis); ++upper) {
             const bool outside = upper ? x[axis] > tankMax_[axis] : x[axis] < tankMin_[axis];
             if (!outside) continue;
             if (scene_.isOpen(axis, upper) || type == kSpray) {

@@ -50,6 +50,9 @@ class WhitewaterStepper {
   // The fluid at a point, from the grid of the substep's interpolated fluid.
   FluidSample sampleFluid(const Eigen::Vector3f& p) const;
   void sortFluid(const std::vector<Eigen::Vector3f>& x, const std::vector<Eigen::Vector3f>& v);
+  // domain.periodic: appends to x and v the images, a period away, of the particles within two kernel radii of a
+  // periodic face, so that the grid (the domain and two radii about it) finds neighbours across the seam.
+  void appendImages(std::vector<Eigen::Vector3f>& x, std::vector<Eigen::Vector3f>& v) const;
 
   // visit(slot, r2) for each fluid particle of the sorted grid within h of p.
   template <typename Visit>
@@ -64,6 +67,7 @@ class WhitewaterStepper {
   const WhitewaterSettings& settings_;
   float h_, restSum_, speed_, timeScale_, frameTime_;
   Eigen::Vector3f gravity_, tankMin_, tankMax_;
+  PeriodicDomain<3> periodic_;
   NeighborGrid<3> grid_;
   std::vector<Eigen::Vector3f> sortedX_, sortedV_;  // the fluid in the grid's order
   std::vector<float> coordinates_;                   // sortedX_ as x, y and z arrays, for keepInRange

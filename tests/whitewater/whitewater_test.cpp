@@ -1,10 +1,14 @@
 // The diffuse particles' motion (whitewater/whitewater.h) against closed forms: a spray particle's projectile with
-// linear air drag, a bubble's rise to its terminal velocity in still water, foam on a rigidly turning pool.
+// linear air drag, a bubble's rise to its terminal velocity in still water, foam on a rigidly turning pool, foam
+// carried round a periodic seam, and a sheared stream that makes as much by the seam as in its middle.
 #include "whitewater/whitewater.h"
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <map>
+#include <string>
 
 namespace surge {
 namespace {
@@ -190,6 +194,90 @@ TEST(Whitewater, SprayBreaksOnAColliderAndBubblesStayOutOfIt) {
   const Eigen::Vector3f p = bubble.position[0];
   const Eigen::Vector3f inside = (p - Eigen::Vector3f(0.6f, 0.5f, 0.5f)).cwiseAbs();
   EXPECT_GE(inside.maxCoeff(), 0.1f - 1e-5f) << "the bubble is inside the box at " << p.transpose();
+}
+
+// A layer 0.1 deep filling a domain periodic along x, flowing along x at U = 2 m/s: frame f is the layer moved
+// U f / fps and brought back into the domain. Walled at x = 0 and 1 (periodic = false) it is a slab whose ends
+// move.
+Scene streamScene(bool periodic) {
+  return parseScene(std::string(R"({"name": "stream", "dimensions": 3,
+    "domain": {"min": [0, 0, 0], "max": [1, 1, 1])") + (periodic ? R"(, "periodic": ["x"])" : "") + R"(},
+    "particle_spacing": 0.02, "fluids": [{"box": {"min": [0, 0, 0.3], "max": [1, 0.1, 0.7]}}],
+    "output": {"fps": 30, "frames": 10}, "whitewater": {"enabled": 1, "lifetime_min": 100, "lifetime_max": 100}})",
+                    "test");
+}
+
+ParticleFrame stream(int frame) {
+  const float speed = 2, moved = speed * float(frame) / 30;
+  ParticleFrame f = block({0, 0, 0.3f}, {1, 0.1f, 0.7f}, 0.02f);
+  for (size_t i = 0; i < f.size(); ++i) {
+    f.position[i].x() = std::fmod(f.position[i].x() + moved, 1.0f);
+    f.velocity[i] = {speed, 0, 0};
+  }
+  return f;
+}
+
+// Foam on the stream rides it round the seam: one starting 5 cm before the seam and one 20 spacings behind it
+// keep the stream's speed (the fitted velocity is exact for a uniform flow), the same kind (they see the same
+// lattice about them) and their distance along x, every frame while each crosses the seam once. Unwrapped, the first would meet the wall at
+// x = 1; without the images across the seam it would see half its neighbours there.
+TEST(Whitewater, FoamRidesAStreamRoundAPeriodicSeam) {
+  const Scene scene = streamScene(true);  // the stepper keeps a reference
+  WhitewaterStepper stepper(scene);
+  DiffuseFrame foam = oneParticle({0.95f, 0.095f, 0.5f}, {2, 0, 0}, kFoam);
+  foam.position.push_back({0.55f, 0.095f, 0.5f});
+  foam.velocity.push_back({2, 0, 0});
+  foam.id.push_back(1);
+  foam.type.push_back(kFoam);
+  foam.lifetime.push_back(100);
+  foam.nextId = 2;
+  for (int f = 0; f < 10; ++f) {
+    stepper.advance(stream(f), stream(f + 1), f, foam);
+    ASSERT_EQ(foam.size(), 2u) << "frame " << f + 1;
+    EXPECT_EQ(stepper.counts().born, 0u) << "a uniform stream makes no whitewater";
+    const float travelled = 2.0f * float(f + 1) / 30;
+    for (size_t k = 0; k < 2; ++k) {
+      EXPECT_EQ(foam.type[k], foam.type[1]) << "frame " << f + 1;
+      EXPECT_NEAR(foam.velocity[k].x(), 2.0f, 1e-4f) << "foam " << k << ", frame " << f + 1;
+      const float start = k == 0 ? 0.95f : 0.55f;
+      EXPECT_NEAR(foam.position[k].x(), std::fmod(start + travelled, 1.0f), 1e-4f) << "foam " << k;
+      EXPECT_GE(foam.position[k].x(), 0.0f);
+      EXPECT_LT(foam.position[k].x(), 1.0f);
+    }
+  }
+  EXPECT_NE(foam.type[1], kSpray);
+}
+
+// A sheared stream, u = 2 + 20 (y - 0.05) m/s, makes whitewater by the seam as it does in its middle: Ihmsen's
+// potentials (trapped air from the rows' relative motion, the surface's crests, the kinetic energy) of each
+// particle equal those of the particle half the period along x, to float rounding (its neighbours summed in
+// another order). Without the images across the seam, the particles there would see half their neighbours and
+// a surface facing along x.
+TEST(Whitewater, AShearedStreamMakesWhitewaterByAPeriodicSeamAsInItsMiddle) {
+  const Scene scene = streamScene(true);
+  WhitewaterStepper stepper(scene);
+  ParticleFrame sheared = stream(0);
+  for (size_t i = 0; i < sheared.size(); ++i) sheared.velocity[i].x() = 2 + 20 * (sheared.position[i].y() - 0.05f);
+  const WhitewaterStepper::Potentials p = stepper.potentials(sheared);
+  // The lattice's sites, (x, y, z) in spacings; x runs over 50.
+  std::map<std::array<int, 3>, size_t> site;
+  auto at = [&](const Eigen::Vector3f& x) {
+    return std::array<int, 3>{int(std::lround((x.x() - 0.01f) / 0.02f)), int(std::lround((x.y() - 0.01f) / 0.02f)),
+                              int(std::lround((x.z() - 0.31f) / 0.02f))};
+  };
+  for (size_t i = 0; i < sheared.size(); ++i) site[at(sheared.position[i])] = i;
+  ASSERT_EQ(site.size(), sheared.size());
+  double trapped = 0;
+  for (size_t i = 0; i < sheared.size(); ++i) {
+    std::array<int, 3> half = at(sheared.position[i]);
+    half[0] = (half[0] + 25) % 50;
+    const size_t j = site.at(half);
+    EXPECT_NEAR(p.trappedAir[i], p.trappedAir[j], 1e-5f) << "particle at " << sheared.position[i].transpose();
+    EXPECT_NEAR(p.waveCrest[i], p.waveCrest[j], 1e-5f) << "particle at " << sheared.position[i].transpose();
+    EXPECT_NEAR(p.generated[i], p.generated[j], 1e-5f * std::max(1.0f, p.generated[j]));
+    trapped += p.trappedAir[i];
+  }
+  EXPECT_GT(trapped, 1.0) << "the shear traps air (the comparison is not of zeros)";
 }
 
 }  // namespace
