@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cctype>
+
 #include <cstdlib>
 
 #include "core/errors.h"
@@ -90,6 +92,32 @@ TEST(SolverDefaults, EachMethodsRegistrationResolvesItsOwnDefaults) {
         kValid, "s", {choice, "solver.substeps=5", "solver.background_pressure=1e4", "domain.max=[0.4,0.5,0.5]"}));
     ASSERT_EQ(full.size(), own) << method;
     if (own) EXPECT_NE(full[0].find("stirs a fluid at rest"), std::string::npos) << full[0];
+  }
+  // A body in a viscous fluid: DFSPH's note when nu dt / a^2 is over 0.15 at the largest step (a ball of radius
+  // 0.05 in nu = 0.37: 3.08 at 1 / 24 s over 2 substeps; a 1 ms step, 0.148, none), naming the solid; PBF's and
+  // WCSPH's that their drag falls short; none without viscosity, without a body, or for a collider that stands.
+  const std::vector<std::string> honey = {"fluids[0].viscosity=0.37",
+      R"(bodies=[{"name": "ball", "shape": "sphere", "radius": 0.05, "position": [0.7, 0.3, 0.25], "density": 7800}])"};
+  auto with = [&](std::vector<std::string> sets, const std::vector<std::string>& more) {
+    sets.insert(sets.end(), more.begin(), more.end());
+    return solverNotes(parseScene(kValid, "s", sets));
+  };
+  const std::vector<std::string> coarse = with(honey, {"solver.method=dfsph"});
+  ASSERT_EQ(coarse.size(), 1u);
+  EXPECT_NE(coarse[0].find("here it is 3.08 for ball (a = 0.05 m)"), std::string::npos) << coarse[0];
+  EXPECT_NE(coarse[0].find("solver.time_step 0.00101"), std::string::npos) << coarse[0];
+  EXPECT_TRUE(with(honey, {"solver.method=dfsph", "solver.time_step=0.001"}).empty());
+  EXPECT_TRUE(with({honey[1]}, {"solver.method=dfsph"}).empty());
+  EXPECT_TRUE(with({honey[0]}, {"solver.method=dfsph"}).empty());
+  EXPECT_TRUE(with({honey[0], R"(colliders=[{"shape": "sphere", "radius": 0.05, "position": [0.7, 0.3, 0.25]}])"},
+                   {"solver.method=dfsph"}).empty());
+  for (const char* method : {"PBF", "WCSPH"}) {
+    std::string name = method;
+    for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::vector<std::string> notes = with(honey, {"solver.method=" + name});
+    ASSERT_EQ(notes.size(), 1u) << method;
+    EXPECT_NE(notes[0].find(std::string(method) + "'s drag on a solid moving through a viscous fluid"),
+              std::string::npos);
   }
   // A name the registry does not hold is refused as the scene is read.
   try {
