@@ -49,6 +49,18 @@ awk -F, '$2 == "ball" { if ($11 < lo) lo = $11; if ($11 > hi) hi = $11 }
   END { printf "light ball (1500, nu 0.136): vertical velocity between %.3f and %.3f m/s over 12 frames, Stokes with the wall factor about %.4f\n",
                lo, hi, 0.62 * 2 * 500 * 9.81 * 0.05 ^ 2 / (9 * 136) }' "$work/light/bodies.csv"
 
+# 3D: the steel ball at the centre of a sphere of radius 0.25 full of fluid (a container collider), for which
+# the wall factor is exact at the centre (Happel and Brenner): K = 1.756 at a / b = 0.2. At 2 ms steps.
+run jar "{\"name\": \"jar\", \"dimensions\": 3, \"domain\": {\"min\": [0, 0, 0], \"max\": [0.52, 0.52, 0.52]},
+  \"particle_spacing\": 0.0125, \"gravity\": [0, -9.81, 0], \"solver\": {\"method\": \"dfsph\", \"time_step\": 0.002},
+  \"fluids\": [{\"box\": {\"min\": [0, 0, 0], \"max\": [0.52, 0.52, 0.52]}, \"viscosity\": 0.37}], \"output\": {\"fps\": 40, \"frames\": 24},
+  \"colliders\": [{\"name\": \"jar\", \"shape\": \"sphere\", \"container\": 1, \"position\": [0.26, 0.26, 0.26], \"radius\": 0.25}],
+  \"bodies\": [{\"name\": \"ball\", \"shape\": \"sphere\", \"position\": [0.26, 0.26, 0.26], \"radius\": 0.05, \"density\": 7800}]}"
+awk -F, '$2 == "ball" { y[$1] = $4 } END { u = (y[8] - y[24]) / 0.4; stokes = 2 * 6800 * 9.81 * 0.05 ^ 2 / (9 * 370);
+  l = 0.2; K = (1 - l ^ 5) / (1 - 2.25 * l + 2.5 * l ^ 3 - 2.25 * l ^ 5 + l ^ 6);
+  printf "steel ball in a sphere of fluid, 2 ms steps: settles at %.4f m/s, Stokes %.4f, with the container %.4f (%.3f)\n",
+         u, stokes, stokes / K, u * K / stokes }' "$work/jar/bodies.csv"
+
 # 2D: a steel disc of radius 0.05 settling down the middle of a channel 0.5 wide and 1.2 tall (Faxen's drag for a
 # cylinder between two walls carries its weight less buoyancy), at DFSPH's own step and at 1 ms (the test's).
 for step in 0 0.001; do
