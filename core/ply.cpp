@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/scene.h"
 
 namespace surge {
 namespace {
@@ -490,6 +491,28 @@ TriangleMesh readMeshPly(const fs::path& path) {
     for (size_t k = 1; k + 1 < items; ++k) mesh.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
   }
   return mesh;
+}
+
+// domain.periodic: the frame with the particles within `reach` of a periodic face copied a period over (both
+// faces of an axis, and on from the first axis's copies to the second's, so a corner gets its diagonal image).
+ParticleFrame withPeriodicImages(const ParticleFrame& frame, const Scene& scene, double reach) {
+  ParticleFrame out = frame;
+  for (int k = 0; k < scene.dimensions; ++k) {
+    if (!scene.isPeriodic(k)) continue;
+    const double lo = scene.domain.min[k], hi = scene.domain.max[k], period = hi - lo;
+    const size_t n = out.size();
+    for (size_t i = 0; i < n; ++i)
+      for (const double shift : {period, -period}) {
+        const double x = out.position[i][k];
+        if (shift > 0 ? x >= lo + reach : x <= hi - reach) continue;
+        out.position.push_back(out.position[i]);
+        out.position.back()[k] = float(x + shift);
+        out.velocity.push_back(out.velocity[i]);
+        out.id.push_back(out.id[i]);
+        if (!out.fluid.empty()) out.fluid.push_back(out.fluid[i]);
+      }
+  }
+  return out;
 }
 
 }  // namespace surge

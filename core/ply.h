@@ -37,6 +37,11 @@ void writeParticlePly(const fs::path& path, const ParticleFrame& frame);
 // Throws InputError naming the file and the header line or property at fault.
 ParticleFrame readParticlePly(const fs::path& path);
 
+struct Scene;
+// domain.periodic: the frame with the particles within `reach` of a periodic face copied a period over, after
+// its own (the surfacer's level set and the whitewater's neighbours run on across the seam with them).
+ParticleFrame withPeriodicImages(const ParticleFrame& frame, const Scene& scene, double reach);
+
 // A whitewater frame (whitewater/frame_NNNNN.ply): the diffuse particles as x y z vx vy vz id type lifetime,
 // and the next id to give in a comment, so that the stage continues from a frame as from memory.
 enum DiffuseType : uint8_t { kSpray = 0, kFoam = 1, kBubble = 2 };

@@ -69,36 +69,13 @@ WhitewaterStepper::WhitewaterStepper(const Scene& scene)
   periodic_ = PeriodicDomain<3>(scene);
 }
 
-void WhitewaterStepper::appendImages(std::vector<Eigen::Vector3f>& x, std::vector<Eigen::Vector3f>& v) const {
-  if (!periodic_.active()) return;
-  // Two radii: an image's own surface normal (eq. 4's n_j) is then whole wherever it is a neighbour. The domain
-  // is at least three radii long on a periodic axis (core/scene_validate.cpp), so each particle has one image.
-  const float band = 2 * h_;
-  const size_t n = x.size();
-  for (size_t i = 0; i < n; ++i) {
-    int side[3] = {0, 0, 0};  // +1: near the lower face, its image a period up; -1: near the upper face
-    bool near = false;
-    for (int k = 0; k < 3; ++k) {
-      if (!periodic_.periodic(k)) continue;
-      if (x[i][k] < periodic_.min(k) + band) side[k] = 1;
-      else if (x[i][k] > periodic_.min(k) + periodic_.period(k) - band) side[k] = -1;
-      near = near || side[k] != 0;
-    }
-    if (!near) continue;
-    // Every combination of the axes it is near (one image by a face, three by an edge, seven by a corner).
-    for (int mask = 1; mask < 8; ++mask) {
-      Eigen::Vector3f image = x[i];
-      bool valid = true;
-      for (int k = 0; k < 3 && valid; ++k)
-        if (mask >> k & 1) {
-          valid = side[k] != 0;
-          image[k] += float(side[k]) * periodic_.period(k);
-        }
-      if (!valid) continue;
-      x.push_back(image);
-      v.push_back(v[i]);
-    }
+void WhitewaterStepper::sortFluidAndImages(const ParticleFrame& fluid) {
+  if (!periodic_.active()) {
+    sortFluid(fluid.position, fluid.velocity);
+    return;
   }
+  const ParticleFrame all = withPeriodicImages(fluid, scene_, 2 * h_);
+  sortFluid(all.position, all.velocity);
 }
 
 bool WhitewaterStepper::meetColliders(Eigen::Vector3f& p, Eigen::Vector3f& v, bool spray,
@@ -180,13 +157,7 @@ WhitewaterStepper::FluidSample WhitewaterStepper::sampleFluid(const Eigen::Vecto
 
 WhitewaterStepper::Potentials WhitewaterStepper::potentials(const ParticleFrame& a) {
   const size_t n = a.size();
-  if (periodic_.active()) {
-    std::vector<Eigen::Vector3f> x = a.position, v = a.velocity;
-    appendImages(x, v);
-    sortFluid(x, v);
-  } else {
-    sortFluid(a.position, a.velocity);
-  }
+  sortFluidAndImages(a);
   const size_t all = sortedX_.size();  // the fluid and its images
   grid_.findNeighbors(sortedX_, h_, lists_);
   const std::vector<uint32_t>& order = grid_.sortedOrder();
@@ -328,21 +299,23 @@ void WhitewaterStepper::advance(const ParticleFrame& a, const ParticleFrame& b, 
 
   // Section 6: substeps through the fluid at each substep's middle time.
   std::vector<uint8_t> dead(diffuse.size(), 0);
-  std::vector<Eigen::Vector3f> xm(n), vm(n);
+  ParticleFrame middle;  // the fluid at a substep's middle time, matched to a by index
+  middle.position.resize(n);
+  middle.velocity.resize(n);
+  middle.id = a.id;
+  std::vector<Eigen::Vector3f>& xm = middle.position;
+  std::vector<Eigen::Vector3f>& vm = middle.velocity;
   const float buoyancy = float(w.bubble_buoyancy);
   std::vector<Pose> poses(colliders_.size());
   for (int step = 0; step < substeps; ++step) {
     const float t = (float(step) + 0.5f) / float(substeps);
     for (size_t c = 0; c < colliders_.size(); ++c)
       poses[c] = colliderPose(scene_.colliders[c], (double(frame) + double(step + 1) / substeps) * frameTime_);
-    xm.resize(n);
-    vm.resize(n);
     parallelFor(0, n, [&](size_t b0, size_t e0) {
       for (size_t i = b0; i < e0; ++i) xm[i] = lerp(a.position[i], xb[i], t), vm[i] = lerp(a.velocity[i], vb[i], t);
     });
     periodic_.wrap(xm);
-    appendImages(xm, vm);
-    sortFluid(xm, vm);
+    sortFluidAndImages(middle);
     parallelFor(0, diffuse.size(), [&](size_t b0, size_t e0) {
       for (size_t k = b0; k < e0; ++k) {
         if (dead[k] || birthStep[k] > step) continue;

@@ -50,9 +50,10 @@ class WhitewaterStepper {
   // The fluid at a point, from the grid of the substep's interpolated fluid.
   FluidSample sampleFluid(const Eigen::Vector3f& p) const;
   void sortFluid(const std::vector<Eigen::Vector3f>& x, const std::vector<Eigen::Vector3f>& v);
-  // domain.periodic: appends to x and v the images, a period away, of the particles within two kernel radii of a
-  // periodic face, so that the grid (the domain and two radii about it) finds neighbours across the seam.
-  void appendImages(std::vector<Eigen::Vector3f>& x, std::vector<Eigen::Vector3f>& v) const;
+  // Sorts `fluid` into the grid; on a periodic domain with its images within two kernel radii of each periodic
+  // face after it (withPeriodicImages), so that the grid (the domain and two radii about it) finds neighbours
+  // across the seam. Two radii: an image's own surface normal (eq. 4's n_j) is whole where it is a neighbour.
+  void sortFluidAndImages(const ParticleFrame& fluid);
 
   // visit(slot, r2) for each fluid particle of the sorted grid within h of p.
   template <typename Visit>
