@@ -134,21 +134,22 @@ TEST(Viscosity, HoneyRunsAtTheStepWaterTakes) {
 // A disc of radius a = 0.05 (4 spacings) dragged at U = 0.1 m/s down the middle of a channel 2 l = 0.5 wide and
 // 2 long, full of a fluid of nu = 0.37 (Re = U a / nu = 0.014), feels Faxen's drag for a cylinder midway between
 // two walls, F = 4 pi mu U / (ln(l / a) - 0.9157 + 1.7244 (a/l)^2 - 1.7302 (a/l)^4) = 612 N/m. The frame-mean
-// drag (colliders.csv) over frames 8 to 32 (0.2 to 0.8 s; the start-up takes l^2 / nu = 0.17 s, the disc moves
-// 0.08 m, the channel's ends 1 m off). DFSPH at 1 ms steps (nu dt / a^2 = 0.15), within the 10% the issue asks
-// of Stokes settling: the pressure the viscosity solve sees is last step's (the incremental correction), and
-// splitting the two costs the drag about dt nu / a^2 of itself. With the pressure applied after the viscosity
-// solve only: 0.83 of Faxen's. At DFSPH's own step (6 ms here) the drag is printed, not bounded: 0.76 (0.53
-// before). docs/viscosity.md has the table by step.
+// drag (colliders.csv) over frames 8 to 40 (0.2 to 1 s; the start-up takes l^2 / nu = 0.17 s, the disc moves
+// 0.1 m, the channel's ends 1 m off; a frame's drag varies by about 15%, so the mean of 33 carries about 3%).
+// DFSPH at 1 ms steps (nu dt / a^2 = 0.15), within the 10% the issue asks of Stokes settling: the pressure the
+// viscosity solve sees is last step's (the incremental correction). Measured 0.955; with the pressure applied
+// after the viscosity solve only, 0.826. At DFSPH's own step (6 ms here) the drag is printed, not bounded: 0.76
+// over frames 8 to 32 (0.53 before). docs/viscosity.md has the table by step.
 TEST(Viscosity, ADiscDraggedThroughHoneyBetweenWallsFeelsFaxensDragInDfsph) {
   const std::string json = R"({"name": "disc", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.5, 2.0]},
     "particle_spacing": 0.0125, "gravity": [0, 0], "solver": {"method": "dfsph"},
-    "fluids": [{"box": {"min": [0, 0], "max": [0.5, 2.0]}, "viscosity": 0.37}], "output": {"fps": 40, "frames": 32},
+    "fluids": [{"box": {"min": [0, 0], "max": [0.5, 2.0]}, "viscosity": 0.37}], "output": {"fps": 40, "frames": 40},
     "colliders": [{"name": "disc", "shape": "sphere", "position": [0.25, 1.0], "radius": 0.05,
       "motion": [{"time": 0, "position": [0.25, 1.0]}, {"time": 1, "position": [0.25, 0.9]}]}]})";
   const double faxen = faxenDragPerSpeed(1000 * 0.37, 0.05, 0.25) * 0.1;
-  const double drag = meanColliderFy(runScene(parseScene(json, "test", {"solver.time_step=0.001"}), "faxen"), 8, 32);
-  const double own = meanColliderFy(runScene(parseScene(json, "test"), "faxen_own_step"), 8, 32);
+  const double drag = meanColliderFy(runScene(parseScene(json, "test", {"solver.time_step=0.001"}), "faxen"), 8, 40);
+  const double own =
+      meanColliderFy(runScene(parseScene(json, "test", {"output.frames=32"}), "faxen_own_step"), 8, 32);
   std::printf("disc dragged through honey (DFSPH): %.0f N/m at 1 ms steps, %.0f at its own, Faxen %.0f\n", drag, own,
               faxen);
   EXPECT_NEAR(drag / faxen, 1.0, 0.10);
