@@ -279,7 +279,6 @@ static void validatePeriodic(const Scene& s, const std::string& where) {
                        "the domain along " + axis + " must be at least 3 kernel radii (" +
                            formatNumber(3 * s.solver.kernel_radius) + " m) to wrap");
   }
-  // The whitewater stage's neighbour search and tank do not wrap yet (docs/viscosity.md, left to do).
 }
 
 void validateScene(Scene& s, const std::string& where) {

@@ -45,15 +45,16 @@ std::pair<double, std::string> smallestMovingSolid(const Scene& scene) {
   return smallest;
 }
 
-// Viscous drag on solids depends on the step (docs/viscosity.md, "The pressure the viscosity solve sees"): DFSPH
-// meets Faxen's within 10% at nu dt / a^2 <= 0.15 (a disc 4 spacings in radius; 0.76 of it at 0.93); PBF's falls
-// short at any practical step and WCSPH's builds up through a run.
+// A figure for a note, to three significant digits.
 std::string threeFigures(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.3g", value);
   return text;
 }
 
+// Viscous drag on solids depends on the step (docs/viscosity.md, "The pressure the viscosity solve sees"): DFSPH
+// meets Faxen's within 10% at nu dt / a^2 <= 0.15 (a disc 4 spacings in radius; 0.76 of it at 0.93); PBF's falls
+// short at any practical step and WCSPH's builds up through a run.
 void viscousDragNote(const Scene& scene, std::vector<std::string>& notes) {
   if (!sceneHasViscosity(scene)) return;
   const auto [a, name] = smallestMovingSolid(scene);
@@ -73,8 +74,9 @@ void viscousDragNote(const Scene& scene, std::vector<std::string>& notes) {
                                                  : 1 / (scene.output.fps * std::max(1, scene.solver.substeps));
   const double ratio = nu * step / (a * a);
   if (ratio <= 0.15) return;
-  notes.push_back("the drag on a solid moving through a viscous fluid comes within 10% once nu dt / a^2 is under 0.15 (a its "
-                  "radius or half-width; DFSPH's disc felt 0.76 of it at 0.93): here it is " + threeFigures(ratio) +
+  notes.push_back("the drag on a solid moving through a viscous fluid comes within 10% once nu dt / a^2 is under "
+                  "0.15 (a its radius or half-width; DFSPH's disc felt 0.76 of it at 0.93): here it is " +
+                  threeFigures(ratio) +
                   " for " + name + " (a = " + threeFigures(a) + " m) at the largest step, " + threeFigures(step) +
                   " s; solver.time_step " + threeFigures(0.15 * a * a / nu) + " gives 0.15 (docs/viscosity.md)");
 }

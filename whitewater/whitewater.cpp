@@ -302,7 +302,7 @@ void WhitewaterStepper::advance(const ParticleFrame& a, const ParticleFrame& b, 
   ParticleFrame middle;  // the fluid at a substep's middle time, matched to a by index
   middle.position.resize(n);
   middle.velocity.resize(n);
-  middle.id = a.id;
+  if (periodic_.active()) middle.id = a.id;  // withPeriodicImages copies the ids with the images
   std::vector<Eigen::Vector3f>& xm = middle.position;
   std::vector<Eigen::Vector3f>& vm = middle.velocity;
   const float buoyancy = float(w.bubble_buoyancy);
