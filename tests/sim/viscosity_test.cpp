@@ -39,13 +39,16 @@ Scene shearScene(const std::string& method, double nu, const std::vector<std::st
   return parseScene(json, "test", overrides);
 }
 
-// The wave's amplitude over the middle third of the tank, by least squares on sin(k y).
-double amplitude(const FluidSolver<2>& solver) {
+// The wave's amplitude u = A sin(k y) by least squares over the particles with x in [from, to]: by default the
+// middle third of the 2D tank.
+template <int Dim>
+double amplitude(const FluidSolver<Dim>& solver, double k = kWaveNumber, double from = kLength / 3,
+                 double to = 2 * kLength / 3) {
   double along = 0, norm = 0;
   for (size_t i = 0; i < solver.size(); ++i) {
-    const Vec<2>& p = solver.positions()[i];
-    if (p[0] < kLength / 3 || p[0] > 2 * kLength / 3) continue;
-    const double s = std::sin(kWaveNumber * p[1]);
+    const Vec<Dim>& p = solver.positions()[i];
+    if (p[0] < from || p[0] > to) continue;
+    const double s = std::sin(k * p[1]);
     along += s * solver.velocities()[i][0];
     norm += s * s;
   }
@@ -65,7 +68,7 @@ Decay shearDecay(const std::string& method, double nu, double dt, const std::vec
   for (size_t i = 0; i < frame.size(); ++i)
     frame.velocity[i] = Eigen::Vector3f(float(kSpeed * std::sin(kWaveNumber * frame.position[i][1])), 0, 0);
   solver->setParticles(frame);
-  const double start = amplitude(*solver);
+  const double start = amplitude<2>(*solver);
   const double duration = 1 / (nu * kWaveNumber * kWaveNumber);
   int most = 0;
   double time = 0;
@@ -77,7 +80,7 @@ Decay shearDecay(const std::string& method, double nu, double dt, const std::vec
     most = std::max(most, solver->lastViscosityIterations());
     time += step;
   }
-  return {amplitude(*solver) / start, std::exp(-nu * kWaveNumber * kWaveNumber * time), most};
+  return {amplitude<2>(*solver) / start, std::exp(-nu * kWaveNumber * kWaveNumber * time), most};
 }
 
 // Implicit, honey (nu 0.05) at steps 6.7 times the explicit limit 0.125 (h/2)^2 / nu (h = 2 spacings): after
@@ -124,15 +127,7 @@ TEST(Viscosity, ShearWaveDecaysAtTheDiffusionRateIn3D) {
     for (size_t i = 0; i < frame.size(); ++i)
       frame.velocity[i] = Eigen::Vector3f(float(kSpeed * std::sin(wavenumber * frame.position[i][1])), 0, 0);
     solver->setParticles(frame);
-    const auto amplitude3 = [&] {  // least squares on sin(k y), over the whole tank
-      double along = 0, norm = 0;
-      for (size_t i = 0; i < solver->size(); ++i) {
-        const double sine = std::sin(wavenumber * solver->positions()[i][1]);
-        along += sine * solver->velocities()[i][0];
-        norm += sine * sine;
-      }
-      return along / norm;
-    };
+    const auto amplitude3 = [&] { return amplitude<3>(*solver, wavenumber, 0, 1); };  // the whole tank
     const double start = amplitude3(), duration = 1 / (nu * wavenumber * wavenumber);
     double time = 0;
     solver->beginFrame(time);
