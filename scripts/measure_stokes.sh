@@ -3,7 +3,7 @@
 # fluid (Stokes), a sphere and a disc moved through it at a set speed (their drag), and a disc spinning in it (its
 # torque), each printed beside the value it is measured against. The 2D disc's settling at 1 ms is a test
 # (Bodies.ADiscSettlesBetweenWallsAtFaxensSpeedInDfsph); the rest Surge does not meet yet.
-# About 8 minutes on two cores (the 3D runs).
+# About 15 minutes on two cores (the 3D runs; the finest ball alone 6).
 #
 #   scripts/measure_stokes.sh [SURGE_BINARY]
 set -euo pipefail
@@ -62,18 +62,19 @@ awk -F, '$2 == "ball" { y[$1] = $4 } END { u = (y[8] - y[24]) / 0.4; stokes = 2 
          u, stokes, stokes / K, u * K / stokes }' "$work/jar/bodies.csv"
 
 # The same ball started 0.045 above the centre, so that it passes the centre midway through frames 8 to 24 (the
-# container's factor holds at the centre), at 1 ms steps and 4 and 6 spacings a radius (30,722 and 106,435
-# particles; the second about 2 minutes).
-for spacing in 0.0125 0.008333333; do
+# container's factor holds at the centre): at 1 ms steps and 4 and 6 spacings a radius (30,722 and 106,435
+# particles; the second about 2 minutes), and at 0.5 ms and 8 (255,690 particles, about 6 minutes).
+for run in 0.0125:0.001 0.008333333:0.001 0.00625:0.0005; do
+  spacing=${run%:*} step=${run#*:}
   run "jar_centred_$spacing" "{\"name\": \"jar\", \"dimensions\": 3, \"domain\": {\"min\": [0, 0, 0], \"max\": [0.52, 0.52, 0.52]},
-    \"particle_spacing\": $spacing, \"gravity\": [0, -9.81, 0], \"solver\": {\"method\": \"dfsph\", \"time_step\": 0.001},
+    \"particle_spacing\": $spacing, \"gravity\": [0, -9.81, 0], \"solver\": {\"method\": \"dfsph\", \"time_step\": $step},
     \"fluids\": [{\"box\": {\"min\": [0, 0, 0], \"max\": [0.52, 0.52, 0.52]}, \"viscosity\": 0.37}], \"output\": {\"fps\": 40, \"frames\": 24},
     \"colliders\": [{\"name\": \"jar\", \"shape\": \"sphere\", \"container\": 1, \"position\": [0.26, 0.26, 0.26], \"radius\": 0.25}],
     \"bodies\": [{\"name\": \"ball\", \"shape\": \"sphere\", \"position\": [0.26, 0.305, 0.26], \"radius\": 0.05, \"density\": 7800}]}"
-  awk -F, -v s="$spacing" '$2 == "ball" { y[$1] = $4 } END { u = (y[8] - y[24]) / 0.4; stokes = 2 * 6800 * 9.81 * 0.05 ^ 2 / (9 * 370);
+  awk -F, -v s="$spacing" -v dt="$step" '$2 == "ball" { y[$1] = $4 } END { u = (y[8] - y[24]) / 0.4; stokes = 2 * 6800 * 9.81 * 0.05 ^ 2 / (9 * 370);
     l = 0.2; K = (1 - l ^ 5) / (1 - 2.25 * l + 2.5 * l ^ 3 - 2.25 * l ^ 5 + l ^ 6);
-    printf "steel ball through the centre of a sphere of fluid, 1 ms steps, spacing %s: %.4f m/s, with the container %.4f (%.3f)\n",
-           s, u, stokes / K, u * K / stokes }' "$work/jar_centred_$spacing/bodies.csv"
+    printf "steel ball through the centre of a sphere of fluid, steps of %s s, spacing %s: %.4f m/s, with the container %.4f (%.3f)\n",
+           dt, s, u, stokes / K, u * K / stokes }' "$work/jar_centred_$spacing/bodies.csv"
 done
 
 # 2D: a steel disc of radius 0.05 settling down the middle of a channel 0.5 wide and 1.2 tall (Faxen's drag for a
