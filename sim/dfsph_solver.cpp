@@ -315,9 +315,7 @@ void DfsphSolver<Dim>::applyIncrements(const std::vector<float>& increments, flo
   });
 }
 
-// Projected Jacobi on the total lambda of this solve, `total` (>= 0): each pass computes every particle's
-// residual s_i at the current velocities and the increment d_i = max(total_i + s_i / S_i, 0) - total_i, then
-// applies all increments at once. The error is the average of max(s_i, 0) before the pass's correction.
+// The solve's start: a share of last step's total applied to v (and counted in `total` anew).
 template <int Dim>
 void DfsphSolver<Dim>::warmStart(bool density, float dt, std::vector<float>& total) {
   const size_t n = size();
@@ -333,6 +331,9 @@ void DfsphSolver<Dim>::warmStart(bool density, float dt, std::vector<float>& tot
   if (warm) applyIncrements(increments_, dt, total);
 }
 
+// Projected Jacobi on the total lambda of this solve, `total` (>= 0): each pass computes every particle's
+// residual s_i at the current velocities and the increment d_i = max(total_i + s_i / S_i, 0) - total_i, then
+// applies all increments at once. The error is the average of max(s_i, 0) before the pass's correction.
 template <int Dim>
 int DfsphSolver<Dim>::solve(bool density, float dt, double limit, int minimum, std::vector<float>& total,
                             bool warmed) {
