@@ -260,17 +260,27 @@ void DfsphSolver<Dim>::computeTransportAccelerations() {
 template <int Dim>
 void DfsphSolver<Dim>::applyNonPressureForces(float dt, double time) {
   const PhaseTimer timer(times_.forces);
-  const auto external = this->externalForces(dt, time);
+  // An incremental pressure correction (van Kan 1986): the viscosity solve sees last step's pressure, so it holds
+  // the fluid to a solid against the pressure's gradient along it; the density solve then adds only the change.
+  // Applied after it, a disc dragged through honey at the default step felt half of Faxen's drag, the fluid
+  // slipping along it (docs/viscosity.md). That pressure is the warm start's share of last step's, so the
+  // viscosity solve sees the same share of the external forces and the rest follows it: at rest the two cancel,
+  // where a whole step of gravity against 0.8 of its pressure left the no-slip walls holding the other 0.2, and a
+  // ball held still in honey felt -1.2 N of fluid force instead of its 5.1 N of buoyancy.
+  const float before = pressureBeforeViscosity_ ? kDensityWarmStart : 1.0f;
+  const auto external = this->externalForces(before * dt, time);
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) external.kick(x_[i], v_[i]);
   });
   this->kickSurfaceTension(x_, dt);
-  // An incremental pressure correction (van Kan 1986): the viscosity solve sees last step's pressure, so it holds
-  // the fluid to a solid against the pressure's gradient along it; the density solve then adds only the change.
-  // Applied after it, a disc dragged through honey at the default step felt half of Faxen's drag, the fluid
-  // slipping along it (docs/viscosity.md).
   if (pressureBeforeViscosity_) warmStart(true, dt, densityWarm_);
   this->applyViscosity(x_, dt);
+  if (pressureBeforeViscosity_) {
+    const auto rest = this->externalForces((1.0f - before) * dt, time);
+    parallelFor(0, size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) rest.kick(x_[i], v_[i]);
+    });
+  }
   if (xsphC_ > 0) {
     std::vector<VecD>& smoothed = vectorScratch_;
     smoothed.resize(size());
