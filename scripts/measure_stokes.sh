@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The runs behind docs/viscosity.md's "Solids moving through a viscous fluid": a ball settling through a viscous
 # fluid (Stokes), a sphere and a disc moved through it at a set speed (their drag), and a disc spinning in it (its
-# torque), each printed beside the value it is measured against. The 2D disc's settling at 1 ms is a test
-# (Bodies.ADiscSettlesBetweenWallsAtFaxensSpeedInDfsph); the rest Surge does not meet yet.
+# torque), each printed beside the value it is measured against. The 2D disc's settling at 1 and 2 ms is a test
+# (Bodies.ADiscSettlesBetweenWallsAtFaxensSpeedInDfsph), and so is the ball in the sphere of fluid as it passes
+# the centre late, in frames 24 to 40 (Bodies.ABallSettlesThroughASphereOfHoneyAtStokesSpeedInDfsph3D); the runs
+# here measure from frame 8, through the fluid's slump (docs/viscosity.md).
 # About 15 minutes on two cores (the 3D runs; the finest ball alone 6).
 #
 #   scripts/measure_stokes.sh [SURGE_BINARY]

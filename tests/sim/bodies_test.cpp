@@ -351,13 +351,6 @@ TEST(Bodies, MomentumIsExchangedWithTheFluid) {
   EXPECT_LT(rows[15].velocity.x(), 0.8);  // the water slowed the ball
 }
 
-// Bullet's table of body shapes (sim/rigid_bodies.cpp) takes exactly the kinds the shape table lets be a body;
-// any other is an error naming the key, never another shape in its place.
-// A run resumed from a frame ends where the uninterrupted run does, in every method, with a keyframed paddle
-// and a floating box beside each other: particles, bodies.csv and the solver state the same bytes. Before the
-// solids were placed from the step's own time and poses (Colliders::placeAtStepStart), WCSPH's first
-// accelerations of a resumed frame and DFSPH's first density solve met the solids where they stood at time 0:
-// the resumed WCSPH run gained 18 J/m from nowhere and stopped, and DFSPH's box moved otherwise.
 // Stokes settling in 2D: a steel disc (7800 kg/m^3, radius a = 0.05, 4 spacings) sinking down the middle of a
 // channel 2 l = 0.5 wide and 1.2 tall full of a fluid of nu = 0.37 reaches the speed at which Faxen's drag for a
 // cylinder between two walls carries its weight less buoyancy, U = (rho_s - rho) g pi a^2 / (F / U) = 0.0856
@@ -387,6 +380,45 @@ TEST(Bodies, ADiscSettlesBetweenWallsAtFaxensSpeedInDfsph) {
   }
 }
 
+// Stokes settling in 3D: a steel ball (7800 kg/m^3, radius a = 0.05, 4 spacings) sinking through the middle of a
+// sphere of radius b = 0.25 full of a fluid of nu = 0.37 (a `container` collider). Happel and Brenner's exact
+// wall factor for a sphere at the centre of a spherical container, K = (1 - l^5) / (1 - 9/4 l + 5/2 l^3 - 9/4 l^5
+// + l^6) = 1.756 at l = a / b = 0.2, makes Stokes's 2 (rho_s - rho) g a^2 / (9 mu) = 0.1002 m/s 0.0570 (Re =
+// 2 U a / nu = 0.015). Its mean speed from its positions over frames 24 to 40 (0.6 to 1 s), in which it passes the
+// centre (from 0.006 above it to 0.017 below; 1 ms steps), within the 10% the issue asks: 1.002. The window
+// starts late because the fluid is not at rest before: the lattice cut by the curved wall leaves half a spacing
+// unfilled along it, so the fluid slumps into a void at the top and sloshes, and a ball held at the centre feels
+// 1 to 3 N less than its 5.1 N of buoyancy through these frames (docs/viscosity.md): the figure carries up to 8%
+// of it. Over frames 8 to 24, through the slump (started 0.045 above the centre), it read 1.21 before DFSPH's
+// viscosity solve took gravity in the pressure's share, 1.16 since. Seen failing (1.541) with the viscous impulse
+// the ball receives halved.
+TEST(Bodies, ABallSettlesThroughASphereOfHoneyAtStokesSpeedInDfsph3D) {
+  const std::string json = R"({"name": "jar", "dimensions": 3, "domain": {"min": [0, 0, 0], "max": [0.52, 0.52, 0.52]},
+    "particle_spacing": 0.0125, "gravity": [0, -9.81, 0], "solver": {"method": "dfsph", "time_step": 0.001},
+    "fluids": [{"box": {"min": [0, 0, 0], "max": [0.52, 0.52, 0.52]}, "viscosity": 0.37}],
+    "output": {"fps": 40, "frames": 40},
+    "colliders": [{"name": "jar", "shape": "sphere", "container": 1, "position": [0.26, 0.26, 0.26], "radius": 0.25}],
+    "bodies": [{"name": "ball", "shape": "sphere", "position": [0.26, 0.335, 0.26], "radius": 0.05,
+                "density": 7800}]})";
+  const double a = 0.05, l = a / 0.25, mu = 1000 * 0.37;
+  const double stokes = 2 * (7800 - 1000) * 9.81 * a * a / (9 * mu);
+  const double factor = (1 - std::pow(l, 5)) /
+                        (1 - 2.25 * l + 2.5 * std::pow(l, 3) - 2.25 * std::pow(l, 5) + std::pow(l, 6));
+  Scene scene = parseScene(json, "test");
+  scene.name = "stokes_jar";
+  const std::vector<BodyRow> rows = readBodies(runScene(scene), "ball");
+  ASSERT_EQ(rows.size(), 41u);
+  const double speed = (rows[24].position.y() - rows[40].position.y()) / (16 / 40.0);
+  std::printf("ball settling through a sphere of honey (DFSPH, 3D): %.4f m/s, Stokes in the container %.4f (%.3f)\n",
+              speed, stokes / factor, speed * factor / stokes);
+  EXPECT_NEAR(speed * factor / stokes, 1.0, 0.10);
+}
+
+// A run resumed from a frame ends where the uninterrupted run does, in every method, with a keyframed paddle
+// and a floating box beside each other: particles, bodies.csv and the solver state the same bytes. Before the
+// solids were placed from the step's own time and poses (Colliders::placeAtStepStart), WCSPH's first
+// accelerations of a resumed frame and DFSPH's first density solve met the solids where they stood at time 0:
+// the resumed WCSPH run gained 18 J/m from nowhere and stopped, and DFSPH's box moved otherwise.
 TEST(Bodies, AResumedRunEndsWhereTheUninterruptedOneDoesInEveryMethod) {
   for (const std::string method : {"pbf", "dfsph", "wcsph"}) {
     SCOPED_TRACE(method);
@@ -415,6 +447,8 @@ TEST(Bodies, AResumedRunEndsWhereTheUninterruptedOneDoesInEveryMethod) {
   }
 }
 
+// Bullet's table of body shapes (sim/rigid_bodies.cpp) takes exactly the kinds the shape table lets be a body;
+// any other is an error naming the key, never another shape in its place.
 TEST(Bodies, BulletTakesEveryBodyShapeAndRefusesTheRestNamingTheKey) {
   for (const ShapeType& t : shapeTypes()) {
     SCOPED_TRACE(t.name);
