@@ -402,6 +402,16 @@ typename Colliders<Dim>::VecD Colliders<Dim>::wallVelocity(size_t c, const VecD&
 }
 
 template <int Dim>
+typename Colliders<Dim>::VecD Colliders<Dim>::spinAcross(size_t c, const VecD& n) const {
+  const Placed& k = placed_[c];
+  Eigen::Vector3f across = Eigen::Vector3f::Zero();
+  across.template head<Dim>() = n;
+  // wallVelocity is affine in p, its gradient (I - R_previous R^T) / dt.
+  const Eigen::Vector3f change = (across - k.previousRotation * (k.rotation.transpose() * across)) / dt_;
+  return change.template head<Dim>();
+}
+
+template <int Dim>
 void Colliders<Dim>::resetSlots(size_t particles) {
   const size_t chunks = (particles + kChunk - 1) / kChunk;
   slots_.assign(chunks * placed_.size(), Wrench{});

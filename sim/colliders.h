@@ -214,6 +214,12 @@ class Colliders {
 
   // The velocity of collider c's surface at p over the current step.
   VecD wallVelocity(size_t c, const VecD& p) const;
+  // True if solid c turns over the current step; then spinAcross(c, n) is Omega x n, its rigid velocity's change
+  // across the vector n.
+  bool turning(size_t c) const {
+    return placed_[c].moving && dt_ > 0 && placed_[c].rotation != placed_[c].previousRotation;
+  }
+  VecD spinAcross(size_t c, const VecD& n) const;
   float friction(size_t c) const { return placed_[c].friction; }
   float particleRadius() const { return radius_; }
 
@@ -232,13 +238,19 @@ class Colliders {
     resetSlots(particles);
   }
   void addImpulse(size_t particle, size_t c, const VecD& impulse, const VecD& at) {
+    addImpulseOnSolid(particle, c, impulse, at);  // the fluid pushes the collider back
+    if (placed_[c].moving)
+      slots_[(particle / kChunk) * placed_.size() + c].work += double(impulse.dot(wallVelocity(c, at)));
+  }
+  // The same for an impulse the solid takes that the particle does not (the viscous strain's traction, sim/
+  // viscosity.h): force and torque, no work on the fluid.
+  void addImpulseOnSolid(size_t particle, size_t c, const VecD& impulse, const VecD& at) {
     Wrench& w = slots_[(particle / kChunk) * placed_.size() + c];
     Eigen::Vector3d j = Eigen::Vector3d::Zero(), r = Eigen::Vector3d::Zero();
     j.head<Dim>() = impulse.template cast<double>();
     r.head<Dim>() = (at - placed_[c].centre).template cast<double>();
-    w.force -= j;  // the fluid pushes the collider back
+    w.force -= j;
     w.torque -= r.cross(j);
-    if (placed_[c].moving) w.work += double(impulse.dot(wallVelocity(c, at)));
   }
   std::vector<Wrench> takeFrameWrenches(double duration);
   // Every solid's mean force and torque over the step of length dt just taken (the bodies' coupling); the

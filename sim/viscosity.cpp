@@ -198,6 +198,14 @@ void Viscosity<Dim>::recordColliderDrag(const std::vector<VecD>& x, const std::v
       colliders.forEachNear(xi, [&](size_t k, float d, const VecD& normal) {
         const VecD relative = v[i] - colliders.wallVelocity(k, xi);
         colliders.addImpulse(i, k, (m * dt) * (wallTensor(d, normal, keepTangent_[k], nuI) * relative), xi);
+        // The strain's traction that the component-wise operator leaves out, mu (grad u)^T n, is -mu Omega x n at
+        // a rigid no-slip wall: a turning collider takes it, over each particle's share of its wetted area, the
+        // particle's volume over the support (the fluid within the support of a wall is its area times the
+        // support). The fluid does not: inside it the term cancels between neighbours (div u = 0;
+        // docs/viscosity.md). Not a body: given explicitly, a light body's spin would overshoot.
+        if (keepTangent_[k] > 0 && k < colliders.firstBody() && colliders.turning(k))
+          colliders.addImpulseOnSolid(i, k, (m * dt * nuI * keepTangent_[k] / kernel_.radius()) * colliders.spinAcross(k, normal),
+                                      xi - d * normal);
       });
     }
   });
