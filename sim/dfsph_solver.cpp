@@ -266,7 +266,7 @@ void DfsphSolver<Dim>::applyNonPressureForces(float dt, double time) {
   // slipping along it (docs/viscosity.md). That pressure is the warm start's share of last step's, so the
   // viscosity solve sees the same share of the external forces and the rest follows it: at rest the two cancel,
   // where a whole step of gravity against 0.8 of its pressure left the no-slip walls holding the other 0.2, and a
-  // ball held still in honey felt -1.2 N of fluid force instead of its 5.1 N of buoyancy.
+  // ball held still in honey felt -1.5 N of fluid force instead of its 5.1 N of buoyancy.
   const float before = pressureBeforeViscosity_ ? kDensityWarmStart : 1.0f;
   const auto external = this->externalForces(before * dt, time);
   parallelFor(0, size(), [&](size_t b, size_t e) {

@@ -203,9 +203,10 @@ void Viscosity<Dim>::recordColliderDrag(const std::vector<VecD>& x, const std::v
         // particle's volume over the support (the fluid within the support of a wall is its area times the
         // support). The fluid does not: inside it the term cancels between neighbours (div u = 0;
         // docs/viscosity.md). Not a body: given explicitly, a light body's spin would overshoot.
-        if (keepTangent_[k] > 0 && k < colliders.firstBody() && colliders.turning(k))
-          colliders.addImpulseOnSolid(i, k, (m * dt * nuI * keepTangent_[k] / kernel_.radius()) * colliders.spinAcross(k, normal),
-                                      xi - d * normal);
+        if (keepTangent_[k] > 0 && k < colliders.firstBody() && colliders.turning(k)) {
+          const float share = m * dt * nuI * keepTangent_[k] / kernel_.radius();  // dt mu V / h
+          colliders.addImpulseOnSolid(i, k, share * colliders.spinAcross(k, normal), xi - d * normal);
+        }
       });
     }
   });

@@ -199,8 +199,8 @@ TEST(Viscosity, ADiscDraggedThroughHoneyBetweenWallsFeelsFaxensDragInDfsph) {
 // force averaged over frames 8 to 16 (0.2 to 0.4 s; the start's settling ends by frame 4). The bound: the ball's
 // pressure integral over a surface 4 spacings in radius carries a few per cent, frame to frame up to 7% (the same
 // 3D scene reads 4.87 to 5.37 N a frame against 5.14), so their mean is held to 5%. Measured 2D 1.016, 3D 0.994.
-// With the whole step's gravity before the viscosity solve and 0.8 of the pressure: 0.47 in 2D, -1.5 N in 3D (the no-slip
-// wall held the fluid against the rest of the gravity, and the ball carried it; docs/viscosity.md).
+// With the whole step's gravity before the viscosity solve and 0.8 of the pressure: 0.47 in 2D, -1.5 N in 3D
+// (the no-slip wall held the fluid against the rest of the gravity, and the ball carried it; docs/viscosity.md).
 TEST(Viscosity, ABallHeldStillInHoneyFeelsItsBuoyancyInDfsph) {
   for (const int dim : {2, 3}) {
     const std::string json = dim == 3
@@ -211,7 +211,8 @@ TEST(Viscosity, ABallHeldStillInHoneyFeelsItsBuoyancyInDfsph) {
             "colliders": [{"name": "ball", "shape": "sphere", "position": [0.25, 0.35, 0.25], "radius": 0.05}]})"
         : R"({"name": "still", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.5, 0.6]},
             "particle_spacing": 0.0125, "gravity": [0, -9.81], "solver": {"method": "dfsph"},
-            "fluids": [{"box": {"min": [0, 0], "max": [0.5, 0.6]}, "viscosity": 0.37}], "output": {"fps": 40, "frames": 16},
+            "fluids": [{"box": {"min": [0, 0], "max": [0.5, 0.6]}, "viscosity": 0.37}],
+            "output": {"fps": 40, "frames": 16},
             "colliders": [{"name": "ball", "shape": "sphere", "position": [0.25, 0.35], "radius": 0.05}]})";
     const double volume = dim == 3 ? 4.0 / 3 * M_PI * std::pow(0.05, 3) : M_PI * 0.05 * 0.05;
     const double buoyancy = 1000 * 9.81 * volume;
@@ -251,7 +252,8 @@ TEST(Viscosity, ASpinningDiscAndBallFeelCouettesTorque) {
   }
   const std::string ball = R"({"name": "spin", "dimensions": 3, "domain": {"min": [0, 0, 0], "max": [0.52, 0.52, 0.52]},
     "particle_spacing": 0.0125, "gravity": [0, 0, 0], "solver": {"method": "dfsph"},
-    "fluids": [{"box": {"min": [0, 0, 0], "max": [0.52, 0.52, 0.52]}, "viscosity": 0.37}], "output": {"fps": 40, "frames": 12},
+    "fluids": [{"box": {"min": [0, 0, 0], "max": [0.52, 0.52, 0.52]}, "viscosity": 0.37}],
+    "output": {"fps": 40, "frames": 12},
     "colliders": [{"name": "jar", "shape": "sphere", "container": 1, "position": [0.26, 0.26, 0.26], "radius": 0.25},
       {"name": "ball", "shape": "sphere", "position": [0.26, 0.26, 0.26], "radius": 0.05,
        "motion": [{"time": 0, "position": [0.26, 0.26, 0.26]},
