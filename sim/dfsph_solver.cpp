@@ -267,20 +267,18 @@ void DfsphSolver<Dim>::applyNonPressureForces(float dt, double time) {
   // viscosity solve sees the same share of the external forces and the rest follows it: at rest the two cancel,
   // where a whole step of gravity against 0.8 of its pressure left the no-slip walls holding the other 0.2, and a
   // ball held still in honey felt -1.5 N of fluid force instead of its 5.1 N of buoyancy.
+  const auto kickExternal = [&](float share) {
+    const auto external = this->externalForces(share * dt, time);
+    parallelFor(0, size(), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) external.kick(x_[i], v_[i]);
+    });
+  };
   const float before = pressureBeforeViscosity_ ? kDensityWarmStart : 1.0f;
-  const auto external = this->externalForces(before * dt, time);
-  parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) external.kick(x_[i], v_[i]);
-  });
+  kickExternal(before);
   this->kickSurfaceTension(x_, dt);
   if (pressureBeforeViscosity_) warmStart(true, dt, densityWarm_);
   this->applyViscosity(x_, dt);
-  if (pressureBeforeViscosity_) {
-    const auto rest = this->externalForces((1.0f - before) * dt, time);
-    parallelFor(0, size(), [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) rest.kick(x_[i], v_[i]);
-    });
-  }
+  if (pressureBeforeViscosity_) kickExternal(1.0f - before);
   if (xsphC_ > 0) {
     std::vector<VecD>& smoothed = vectorScratch_;
     smoothed.resize(size());

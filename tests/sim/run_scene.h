@@ -3,15 +3,14 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
+#include <algorithm>
 #include <string>
-#include <vector>
 
 #include "core/files.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "sim/simulation.h"
+#include "tests/sim/stats_columns.h"
 
 namespace surge {
 
@@ -29,28 +28,26 @@ inline fs::path runScene(const Scene& scene, const std::string& name, int thread
 // row, for a scene with one collider).
 inline double meanColliderColumn(const fs::path& dir, const std::string& column, int first, int last,
                                  const std::string& name = "") {
-  std::ifstream in(dir / "colliders.csv");
-  std::string line, cell;
-  std::getline(in, line);
-  std::stringstream header(line);
-  int wanted = -1;
-  for (int c = 0; std::getline(header, cell, ','); ++c)
-    if (cell == column) wanted = c;
-  EXPECT_GE(wanted, 2) << column;
+  const auto rows = readCsvRows(dir / "colliders.csv");
+  if (rows.empty()) {
+    ADD_FAILURE() << "no colliders.csv in " << dir;
+    return 0;
+  }
+  const auto found = std::find(rows[0].begin(), rows[0].end(), column);
+  EXPECT_NE(found, rows[0].end()) << column;
+  const size_t wanted = size_t(found - rows[0].begin());
   double sum = 0;
-  int rows = 0;
-  while (std::getline(in, line)) {
-    std::stringstream cells(line);
-    std::vector<std::string> row;
-    while (std::getline(cells, cell, ',')) row.push_back(cell);
-    if (wanted < 0 || row.size() <= size_t(wanted)) continue;
+  int count = 0;
+  for (size_t r = 1; r < rows.size(); ++r) {
+    const auto& row = rows[r];
+    if (row.size() <= wanted) continue;
     const int f = std::stoi(row[0]);
     if (f < first || f > last || (!name.empty() && row[1] != name)) continue;
     sum += std::stod(row[wanted]);
-    ++rows;
+    ++count;
   }
-  EXPECT_EQ(rows, last - first + 1);
-  return rows ? sum / rows : 0;
+  EXPECT_EQ(count, last - first + 1);
+  return count ? sum / count : 0;
 }
 inline double meanColliderFy(const fs::path& dir, int first, int last) {
   return meanColliderColumn(dir, "fy", first, last);
