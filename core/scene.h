@@ -61,7 +61,11 @@ struct SolverSettings {
   // How fluids[i].viscosity acts (sim/viscosity.h): "implicit", "explicit", or "default": explicit for WCSPH,
   // implicit for the others.
   std::string viscosity_solver = "default";
-  double viscosity_max_error = 0.01;  // the implicit solve's residual over the step's viscous change
+  // Its pair term (sim/viscosity.h): "laplacian" (each component's) or "strain" (Weiler et al.'s eq. 8).
+  std::string viscosity_operator = "laplacian";
+  // The implicit solve's residual over the step's viscous change; 0: 0.01, or 0.001 with the strain's operator
+  // (resolveSolverDefaults).
+  double viscosity_max_error = 0;
   int viscosity_max_iterations = 100;
 };
 

@@ -309,9 +309,17 @@ void visitScene(Scene& s, SceneVisitor& v) {
              info("how fluids[i].viscosity acts: implicit, Weiler et al. 2018's backward Euler solved by "
                   "conjugate gradients (no step limit); explicit, Morris et al. 1997 (dt <= 0.125 (h/2)^2 / nu); "
                   "default: explicit for WCSPH, implicit for the others (docs/viscosity.md)"));
+    v.choice("viscosity_operator", s.solver.viscosity_operator, {"laplacian", "strain"},
+             info("the viscosity's pair term: laplacian, the Laplacian of each component (exact on the rest "
+                  "lattice in every direction: for flows between walls); strain, Weiler et al. 2018's eq. 8, on "
+                  "each pair's stretching (a free surface then carries no traction: a column of honey creeps at "
+                  "Trouton's rate, a rope buckles and coils; a shear along a lattice axis reads 0.66 of nu). Free "
+                  "surfaces that stretch, drip or coil want strain (docs/viscosity.md)"));
     v.real("viscosity_max_error", s.solver.viscosity_max_error,
-           positive("the implicit viscosity solve stops when its residual is under this share of the step's "
-                    "viscous change, |r| <= e |b - A v*| (docs/viscosity.md)"));
+           atLeast(0,
+                   "the implicit viscosity solve stops when its residual is under this share of the step's "
+                   "viscous change, |r| <= e |b - A v*|; 0: 0.01, or 0.001 with viscosity_operator strain, whose "
+                   "stiff ropes creep in jerks at 0.01 (docs/viscosity.md)"));
     v.integer("viscosity_max_iterations", s.solver.viscosity_max_iterations,
               atLeast(1, "the most conjugate-gradient iterations of the implicit viscosity solve a step", "", 10000));
     FieldInfo cfl = positive("Courant number. WCSPH: dt <= cfl h / (c + |v|max), h = kernel_radius / 2; DFSPH: "

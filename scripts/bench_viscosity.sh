@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The cost of viscosity and of periodic axes (issue 35), each run beside its baseline in this script, the fastest
 # of three runs kept (a shared machine):
-# - viscosity: `honey` as it ships (nu = 0.05, implicit, DFSPH) beside the same scene with nu = 0, ms a step and
-#   the forces phase (stats.csv ms_viscosity: gravity, XSPH and the viscosity) a step;
+# - viscosity: `honey` as it ships (3D, nu = 0.5, implicit, DFSPH, the strain's operator) beside the same scene
+#   with nu = 0 and with the component-wise operator, ms a step and the forces phase (stats.csv ms_viscosity:
+#   gravity, XSPH and the viscosity) a step;
 # - periodic axes: a 3D pool at rest (50 x 20 x 50 particles) periodic along x and z beside the same pool between
 #   walls, ms a step, in each method;
 # - the transport velocity (solver.background_pressure): Taylor-Green's box (2D, 100 x 100 particles, periodic,
@@ -27,9 +28,14 @@ echo "| honey | ms a step | forces phase, ms a step |"
 echo "|---|---|---|"
 read -r with withPhase < <(best scenes/honey.json --set output.frames="$frames")
 read -r without withoutPhase < <(best scenes/honey.json --set output.frames="$frames" --set 'fluids[0].viscosity=0')
-awk -v a="$without" -v b="$with" -v pa="$withoutPhase" -v pb="$withPhase" 'BEGIN {
-  printf "| nu = 0 | %.3f | %.3f |\n| nu = 0.05 | %.3f | %.3f |\n| ratio | %.3f | viscosity %.0f%% of a step |\n",
-         a, pa, b, pb, b / a, 100 * (pb - pa) / b }'
+read -r laplacian laplacianPhase < <(best scenes/honey.json --set output.frames="$frames" \
+  --set solver.viscosity_operator=laplacian)
+awk -v a="$without" -v b="$with" -v c="$laplacian" -v pa="$withoutPhase" -v pb="$withPhase" -v pc="$laplacianPhase" \
+  'BEGIN {
+  printf "| nu = 0 | %.3f | %.3f |\n| nu = 0.5, strain | %.3f | %.3f |\n| nu = 0.5, laplacian | %.3f | %.3f |\n",
+         a, pa, b, pb, c, pc
+  printf "| ratio, strain to nu = 0 | %.3f | viscosity %.0f%% of a step |\n", b / a, 100 * (pb - pa) / b
+  printf "| ratio, strain to laplacian | %.3f | %.3f |\n", b / c, pb / pc }'
 
 cat >"$work/pool.json" <<'JSON'
 {"name": "pool", "dimensions": 3, "domain": {"min": [0, 0, 0], "max": [0.5, 0.3, 0.5]},

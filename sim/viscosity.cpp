@@ -43,6 +43,7 @@ Viscosity<Dim>::Viscosity(const Scene& scene, float support) {
   active_ = true;
   periodic_ = PeriodicDomain<Dim>(scene);
   implicit_ = implicitViscosity(scene);
+  strain_ = scene.solver.viscosity_operator == "strain";
   kernel_ = CubicSplineKernel<Dim>(support);
   const float spacing = static_cast<float>(scene.particle_spacing);
   const float smoothing = 0.5f * support;
@@ -100,6 +101,7 @@ template <int Dim>
 size_t Viscosity<Dim>::memoryBytes() const {
   size_t bytes = 0;
   for (const auto& chunk : pairFactor_) bytes += chunk.capacity() * sizeof(float);
+  for (const auto& chunk : pairAxis_) bytes += chunk.capacity() * sizeof(VecD);
   bytes += (wall_.capacity() + blockInverse_.capacity()) * sizeof(MatD);
   for (const auto* channel : {&wallDrag_, &start_, &residual_, &direction_, &product_, &preconditioned_})
     bytes += channel->capacity() * sizeof(VecD);
@@ -109,7 +111,9 @@ size_t Viscosity<Dim>::memoryBytes() const {
 
 // A wall's share of B_i at distance d along its normal: the weight sum_b 2 V nu F r^2 / (r^2 + eta) from the
 // normal moment and the tangential ones, on the normal part of the relative velocity and, kept by
-// 1 - viscous_slip, on the tangential part (the no-slip table's extrapolated boundary velocities).
+// 1 - viscous_slip, on the tangential part (the no-slip table's extrapolated boundary velocities). The strain's
+// form takes (d + 2) times each moment on its own part: sum_b F (r . n)^2 / (r^2 + eta) n n^T and its tangential
+// twin, the lattice beyond a flat wall holding no cross terms.
 template <int Dim>
 typename Viscosity<Dim>::MatD Viscosity<Dim>::wallTensor(float d, const VecD& normal, float keepTangent,
                                                          float nu) const {
@@ -117,8 +121,9 @@ typename Viscosity<Dim>::MatD Viscosity<Dim>::wallTensor(float d, const VecD& no
   wallTable_.moments(d, normalMoment, tangentMoment);
   noSlipTable_.moments(d, noSlipNormal, noSlipTangent);
   const MatD across = normal * normal.transpose();
-  const float weight = scale_ * nu * (normalMoment + (Dim - 1) * tangentMoment);
-  const float noSlipWeight = scale_ * nu * (noSlipNormal + (Dim - 1) * noSlipTangent);
+  const float weight = scale_ * nu * (strain_ ? (Dim + 2) * normalMoment : normalMoment + (Dim - 1) * tangentMoment);
+  const float noSlipWeight =
+      scale_ * nu * (strain_ ? (Dim + 2) * noSlipTangent : noSlipNormal + (Dim - 1) * noSlipTangent);
   return weight * across + (keepTangent * noSlipWeight) * (MatD::Identity() - across);
 }
 
@@ -129,6 +134,7 @@ void Viscosity<Dim>::prepare(const std::vector<VecD>& x, const NeighborLists& ne
   sizeForPairs(neighbors, pairFactor_);
   wall_.resize(n);
   wallDrag_.resize(n);
+  if (strain_) sizeForPairs(neighbors, pairAxis_);
   const VecD lower = walls.domainMin(), upper = walls.domainMax();
   const float reach = kernel_.radius();
   const bool several = !fluid.empty();
@@ -140,12 +146,14 @@ void Viscosity<Dim>::prepare(const std::vector<VecD>& x, const NeighborLists& ne
       const VecD xi = x[i];
       const float nuI = nu_[several ? fluid[i] : 0];
       float* c = pairFactor_[i / NeighborLists::kChunk].data() + neighbors.start(i);
+      VecD* axis = strain_ ? pairAxis_[i / NeighborLists::kChunk].data() + neighbors.start(i) : nullptr;
       for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c) {
         VecD r = xi - x[*j];
         wrap(r);
         const float nuIJ = several ? 0.5f * (nuI + nu_[fluid[*j]]) : nuI;
-        const float squared = r.squaredNorm();
-        *c = scale_ * nuIJ * kernel_.gradientFactor(std::sqrt(squared)) * squared / (squared + eta_);
+        const float squared = r.squaredNorm(), distance = std::sqrt(squared);
+        *c = scale_ * nuIJ * kernel_.gradientFactor(distance) * squared / (squared + eta_);
+        if (axis) *axis++ = distance > 0 ? VecD(r / distance) : VecD::Zero();
       }
       // The boundary (eq. 11's b terms): B_i, the walls' tensors summed, and B_i v_b.
       MatD tensor = MatD::Zero();
@@ -175,8 +183,15 @@ void Viscosity<Dim>::laplacian(const std::vector<VecD>& u, const NeighborLists& 
     for (size_t i = b; i < e; ++i) {
       const VecD ui = u[i];
       VecD sum = wall_[i] * ui;
-      const float* c = pairFactor_[i / NeighborLists::kChunk].data() + neighbors.start(i);
-      for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c) sum += *c * (ui - u[*j]);
+      const size_t chunk = i / NeighborLists::kChunk, first = neighbors.start(i);
+      const float* c = pairFactor_[chunk].data() + first;
+      if (!strain_) {
+        for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c) sum += *c * (ui - u[*j]);
+      } else {
+        const VecD* axis = pairAxis_[chunk].data() + first;
+        for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c, ++axis)
+          sum += ((Dim + 2) * *c * axis->dot(ui - u[*j])) * *axis;
+      }
       out[i] = sum;
     }
   });
@@ -202,8 +217,9 @@ void Viscosity<Dim>::recordColliderDrag(const std::vector<VecD>& x, const std::v
         // a rigid no-slip wall: a turning collider takes it, over each particle's share of its wetted area, the
         // particle's volume over the support (the fluid within the support of a wall is its area times the
         // support). The fluid does not: inside it the term cancels between neighbours (div u = 0;
-        // docs/viscosity.md). Not a body: given explicitly, a light body's spin would overshoot.
-        if (keepTangent_[k] > 0 && k < colliders.firstBody() && colliders.turning(k)) {
+        // docs/viscosity.md). Not a body: given explicitly, a light body's spin would overshoot. Not with the
+        // strain's operator, for which it was not derived (not measured there).
+        if (!strain_ && keepTangent_[k] > 0 && k < colliders.firstBody() && colliders.turning(k)) {
           const float share = m * dt * nuI * keepTangent_[k] / kernel_.radius();  // dt mu V / h
           colliders.addImpulseOnSolid(i, k, share * colliders.spinAcross(k, normal), xi - d * normal);
         }
@@ -245,10 +261,19 @@ int Viscosity<Dim>::solveImplicit(const std::vector<VecD>& x, std::vector<VecD>&
   // The diagonal blocks of A: I - dt (sum_j c_ij x_ij x_ij^T + B_i), inverted (block Jacobi).
   parallelFor(0, n, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
-      float pairs = 0;
-      const float* c = pairFactor_[i / NeighborLists::kChunk].data() + neighbors.start(i);
-      for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c) pairs += *c;
-      const MatD block = wall_[i] + pairs * MatD::Identity();
+      const size_t chunk = i / NeighborLists::kChunk, first = neighbors.start(i);
+      MatD pairs = MatD::Zero();
+      const float* c = pairFactor_[chunk].data() + first;
+      if (!strain_) {
+        float sum = 0;
+        for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c) sum += *c;
+        pairs = sum * MatD::Identity();
+      } else {
+        const VecD* axis = pairAxis_[chunk].data() + first;
+        for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c, ++axis)
+          pairs += ((Dim + 2) * *c) * (*axis * axis->transpose());
+      }
+      const MatD block = wall_[i] + pairs;
       blockInverse_[i] = (MatD::Identity() - dt * block).inverse();
       v[i] = start_[i];  // the start: v* plus the last step's change
       for (int k = 0; k < Dim; ++k) v[i][k] += warm_[k][i];

@@ -13,10 +13,13 @@
 // sum_j V (v_ij . x_ij) x_ij F_ij / (|x_ij|^2 + eta): that sum rests on the lattice's fourth moment, which at
 // h = 2 spacings is 0.66 of its integral for a shear along a lattice axis and 1.35 at 45 degrees (a shear wave
 // decayed at 0.64 of nu's rate); the component-wise sum rests on the second moment, 1.01 of its integral in
-// every direction (docs/viscosity.md). The boundary b is the tank's walls and the colliders and bodies as the
-// rest lattice continued beyond them (sim/tank.h), its sum tabulated by the distance to a locally flat wall and
-// applied to the normal part of v_i - v_b and, scaled by (1 - viscous_slip), the tangential part: 0 is no-slip
-// against the wall's own velocity v_b, 1 free slip.
+// every direction (docs/viscosity.md). solver.viscosity_operator strain takes eq. 8's pair term instead,
+//   (d + 2) sum_j V nu_ij F_ij |x_ij|^2 / (|x_ij|^2 + eta) x^_ij x^_ij^T (v_i - v_j),   x^ = x / |x|,
+// on each pair's stretching alone: a free surface then carries no traction, so a rope creeps at Trouton's rate,
+// buckles and coils, where the component-wise sum lets it squash (docs/viscosity.md). The boundary b is the tank's
+// walls and the colliders and bodies as the rest lattice continued beyond them (sim/tank.h), its sum tabulated by the
+// distance to a locally flat wall and applied to the normal part of v_i - v_b and, scaled by (1 - viscous_slip), the
+// tangential part: 0 is no-slip against the wall's own velocity v_b, 1 free slip.
 //
 // `implicit` (solver.viscosity_solver, the default for PBF and DFSPH): backward Euler, eq. 12,
 //   (I - dt nu lap) v = v*,
@@ -109,6 +112,9 @@ class Viscosity {
   FlatWallTable wallTable_;         // the moments of sum_b x_ib grad W_ib^T / (|x_ib|^2 + eta), by distance
   FlatWallTable noSlipTable_;       // the same with each b's share times Morris's 1 + d_b / d_i (the tangential part)
   std::vector<std::vector<float>> pairFactor_;  // c_ij, parallel to the neighbour lists
+  // solver.viscosity_operator strain: the unit x_ij of every pair, parallel to the lists.
+  bool strain_ = false;
+  std::vector<std::vector<VecD>> pairAxis_;
   std::vector<MatD> wall_, blockInverse_;
   std::vector<VecD> wallDrag_;  // B_i v_b
   std::vector<VecD> start_, residual_, direction_, product_, preconditioned_;
