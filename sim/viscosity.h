@@ -30,7 +30,8 @@
 // change rather than |b|, so a fluid's uniform motion does not loosen it; the .cpp) or after
 // viscosity_max_iterations.
 // The matrix is symmetric (one volume V, nu_ij symmetric) and positive definite, so no step limit.
-// `explicit` (Morris 1997, WCSPH's default): v += dt nu lap v, stable for dt <= 0.125 (h/2)^2 / nu.
+// `explicit` (Morris 1997, WCSPH's default): v += dt nu lap v, stable for dt <= 0.125 (h/2)^2 / nu (and d + 2
+// times shorter with the strain's operator).
 // Every loop gathers and every dot product is a parallelSum: the same bytes at any thread count. A scene
 // without viscosity holds no channel and runs no pass.
 #pragma once
