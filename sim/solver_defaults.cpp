@@ -145,7 +145,8 @@ void resolveSolverDefaults(Scene& scene) {
   if (solver.gas_constant == 0) solver.gas_constant = solver.speed_of_sound * solver.speed_of_sound;
   // The strain's operator is stiff along a rope: at 0.01 its warm-started solve lags and a column of honey creeps
   // in jerks at 2.5 times Trouton's rate (docs/viscosity.md).
-  if (solver.viscosity_max_error == 0) solver.viscosity_max_error = solver.viscosity_operator == "strain" ? 1e-3 : 1e-2;
+  if (solver.viscosity_max_error == 0)
+    solver.viscosity_max_error = solver.viscosity_operator == "strain" ? 1e-3 : 1e-2;
   const FluidMethod& method = fluidMethod(solver.method, scene.source);
   if (method.resolveDefaults) method.resolveDefaults(scene);
 }

@@ -156,7 +156,10 @@ void Viscosity<Dim>::prepare(const std::vector<VecD>& x, const NeighborLists& ne
         const float nuIJ = several ? 0.5f * (nuI + nu_[fluid[*j]]) : nuI;
         const float squared = r.squaredNorm(), distance = std::sqrt(squared);
         *c = scale_ * nuIJ * kernel_.gradientFactor(distance) * squared / (squared + eta_);
-        if (axis) *axis++ = distance > 0 ? VecD(r / distance) : VecD::Zero();
+        if (axis) {  // the strain's pair term: (d + 2) c_ij on the pair's axis
+          *c = (Dim + 2) * *c;
+          *axis++ = distance > 0 ? VecD(r / distance) : VecD::Zero();
+        }
       }
       // The boundary (eq. 11's b terms): B_i, the walls' tensors summed, and B_i v_b.
       MatD tensor = MatD::Zero();
@@ -193,7 +196,7 @@ void Viscosity<Dim>::laplacian(const std::vector<VecD>& u, const NeighborLists& 
       } else {
         const VecD* axis = pairAxis_[chunk].data() + first;
         for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c, ++axis)
-          sum += ((Dim + 2) * *c * axis->dot(ui - u[*j])) * *axis;
+          sum += (*c * axis->dot(ui - u[*j])) * *axis;
       }
       out[i] = sum;
     }
@@ -261,7 +264,8 @@ int Viscosity<Dim>::solveImplicit(const std::vector<VecD>& x, std::vector<VecD>&
   direction_.resize(n);
   preconditioned_.resize(n);
   blockInverse_.resize(n);
-  // The diagonal blocks of A: I - dt (sum_j c_ij x_ij x_ij^T + B_i), inverted (block Jacobi).
+  // The diagonal blocks of A: I - dt (sum_j c_ij P_ij + B_i), P the identity or, with the strain's operator, the
+  // pair's projection x^ x^^T; inverted (block Jacobi).
   parallelFor(0, n, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const size_t chunk = i / NeighborLists::kChunk, first = neighbors.start(i);
@@ -274,7 +278,7 @@ int Viscosity<Dim>::solveImplicit(const std::vector<VecD>& x, std::vector<VecD>&
       } else {
         const VecD* axis = pairAxis_[chunk].data() + first;
         for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j, ++c, ++axis)
-          pairs += ((Dim + 2) * *c) * (*axis * axis->transpose());
+          pairs += *c * (*axis * axis->transpose());
       }
       const MatD block = wall_[i] + pairs;
       blockInverse_[i] = (MatD::Identity() - dt * block).inverse();

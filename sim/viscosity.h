@@ -112,7 +112,7 @@ class Viscosity {
   float wallKeepTangent_ = 1;       // the tank's
   FlatWallTable wallTable_;         // the moments of sum_b x_ib grad W_ib^T / (|x_ib|^2 + eta), by distance
   FlatWallTable noSlipTable_;       // the same with each b's share times Morris's 1 + d_b / d_i (the tangential part)
-  std::vector<std::vector<float>> pairFactor_;  // c_ij, parallel to the neighbour lists
+  std::vector<std::vector<float>> pairFactor_;  // c_ij ((d + 2) c_ij with strain), parallel to the lists
   // solver.viscosity_operator strain: the unit x_ij of every pair, parallel to the lists.
   bool strain_ = false;
   std::vector<std::vector<VecD>> pairAxis_;
