@@ -26,16 +26,18 @@ inline double millisecondsSince(PhaseClock::time_point start) {
   return std::chrono::duration<double, std::milli>(PhaseClock::now() - start).count();
 }
 
-// Adds the milliseconds of its own life to one of PhaseTimes' phases.
+// Adds the milliseconds of its own life to one of PhaseTimes' phases. A timer of the same phase inside it (DFSPH's
+// forces around the viscosity's) is counted once: the outer one sets the phase to its start's value plus its life.
 class PhaseTimer {
  public:
-  explicit PhaseTimer(double& phase) : phase_(phase), start_(PhaseClock::now()) {}
-  ~PhaseTimer() { phase_ += millisecondsSince(start_); }
+  explicit PhaseTimer(double& phase) : phase_(phase), before_(phase), start_(PhaseClock::now()) {}
+  ~PhaseTimer() { phase_ = before_ + millisecondsSince(start_); }
   PhaseTimer(const PhaseTimer&) = delete;
   PhaseTimer& operator=(const PhaseTimer&) = delete;
 
  private:
   double& phase_;
+  const double before_;
   PhaseClock::time_point start_;
 };
 
