@@ -2,12 +2,14 @@
 // asks of a scene, beside its solver (sim/wcsph_solver.h).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
 #include "core/scene_fields.h"
 #include "sim/wcsph_solver.h"
 #include "sim/solver_defaults.h"
+#include "sim/viscosity.h"
 
 namespace surge {
 namespace {
@@ -37,7 +39,10 @@ void declareWcsphKeys(SceneVisitor& v, SolverSettings& s) {
 // that a scene with nothing moving (no gravity) still has a runaway speed above zero.
 int wcsphPushesPerFrame(const Scene&) { return 1; }
 
-// A jittered start is compressed, and WCSPH gives that back as motion.
+// A jittered start is compressed, and WCSPH gives that back as motion. Its explicit viscosity (Morris 1997)
+// limits the step to 0.125 (h/2)^2 / nu (over d + 2 with the strain's operator, sim/viscosity.cpp): where that is
+// under a quarter of the sound's step cfl (h/2) / c, the implicit solve takes the sound's (honey's rope at
+// nu = 0.5: 166,667 steps a frame explicit, 692 implicit; docs/viscosity.md).
 std::vector<std::string> wcsphNotes(const Scene& scene) {
   std::vector<std::string> notes;
   for (size_t i = 0; i < scene.fluids.size(); ++i)
@@ -46,6 +51,22 @@ std::vector<std::string> wcsphNotes(const Scene& scene) {
                       "energy back as motion (the energy account credits it in frame 1's source_work)");
       break;
     }
+  double nu = 0;
+  for (size_t f = 0; f < scene.fluids.size(); ++f) nu = std::max(nu, fluidViscosity(scene, f));
+  if (nu > 0 && !implicitViscosity(scene)) {
+    const SolverSettings& s = scene.solver;
+    const double half = 0.5 * s.kernel_radius;
+    const double viscous = 0.125 * half * half / nu / (s.viscosity_operator == "strain" ? scene.dimensions + 2 : 1);
+    const double sound = s.cfl * half / s.speed_of_sound;
+    if (viscous < 0.25 * sound) {
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    "WCSPH's explicit viscosity limits its step to %.3g s here, %.0f times shorter than the sound's "
+                    "(about %.3g steps a frame): solver.viscosity_solver implicit takes the sound's step",
+                    viscous, sound / viscous, 1 / (scene.output.fps * viscous));
+      notes.push_back(text);
+    }
+  }
   return notes;
 }
 

@@ -114,11 +114,22 @@ TEST(SolverDefaults, EachMethodsRegistrationResolvesItsOwnDefaults) {
   for (const char* method : {"PBF", "WCSPH"}) {
     std::string name = method;
     for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
-    const std::vector<std::string> notes = with(honey, {"solver.method=" + name});
+    const std::vector<std::string> notes = with(honey, {"solver.method=" + name, "solver.viscosity_solver=implicit"});
     ASSERT_EQ(notes.size(), 1u) << method;
     EXPECT_NE(notes[0].find(std::string(method) + "'s drag on a solid moving through a viscous fluid"),
               std::string::npos);
   }
+  // WCSPH's explicit viscosity: a note when its step limit 0.125 (h/2)^2 / nu is under a quarter of the sound's,
+  // cfl (h/2) / c. Here h/2 = 0.05 and c = 10 sqrt(2 g 1 m) = 44.3 m/s (resolved as the scene is read), so the
+  // sound's step is 4.52e-4 s; nu = 5 gives 6.25e-5 s, 7 times shorter (none with the implicit solve, above, nor
+  // for nu = 0.37, whose 8.45e-4 s is the longer).
+  const std::vector<std::string> explicitHoney = with({"fluids[0].viscosity=5"}, {"solver.method=wcsph"});
+  ASSERT_EQ(explicitHoney.size(), 1u);
+  EXPECT_NE(explicitHoney[0].find("WCSPH's explicit viscosity limits its step to 6.25e-05 s here, 7 times shorter"),
+            std::string::npos)
+      << explicitHoney[0];
+  EXPECT_TRUE(with({"fluids[0].viscosity=5", "solver.viscosity_solver=implicit"}, {"solver.method=wcsph"}).empty());
+  EXPECT_TRUE(with({honey[0]}, {"solver.method=wcsph"}).empty());
   // A name the registry does not hold is refused as the scene is read.
   try {
     parseScene(kValid, "s", {"solver.method=sph"});
