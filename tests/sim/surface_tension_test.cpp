@@ -157,6 +157,23 @@ TEST(SurfaceTension, AThreeDimensionalDropOscillatesAtRayleighsFrequencyInPbf) {
   EXPECT_NEAR(crossings[0] / (M_PI / omega), 1.0, 0.1);
 }
 
+// The same drop in DFSPH with 2.5 spacings of support (solver.kernel_radius 2.5 mm) in place of the default 2:
+// it first comes back through its rest shape at 0.958 of Rayleigh's half period, and its next four half periods
+// average 0.988 of it, both within the 10%. With 2 spacings the drop keeps a set and never crosses (the
+// test fails); with 3, 0.987 and 0.911 (docs/surface-tension.md).
+TEST(SurfaceTension, AThreeDimensionalDropOscillatesAtRayleighsFrequencyInDfsphWithAWiderKernel) {
+  const double radius = 0.01, omega = std::sqrt(8 * kSigma / (kRho * std::pow(radius, 3)));
+  auto solver = makeFluidSolver<3>(dropScene(3, "dfsph", radius, {"solver.kernel_radius=0.0025"}));
+  relaxDrop<3>(*solver, radius, 0.2);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  const double half = M_PI / omega;
+  const std::vector<double> crossings = oscillationCrossings<3>(*solver, 0.1 * omega, 5 * half, 5);
+  for (double t : crossings) std::printf("back through its rest shape at %.4f half periods\n", t / half);
+  ASSERT_EQ(crossings.size(), 5u) << "the drop did not oscillate";
+  EXPECT_NEAR(crossings[0] / half, 1.0, 0.1);
+  EXPECT_NEAR((crossings[4] - crossings[0]) / 4 / half, 1.0, 0.1);
+}
+
 // The 2:1:1 box of water (24 x 12 x 12 particles at 1 mm) in zero gravity, in `method`.
 Scene boxDropScene(const std::string& method, const std::vector<std::string>& extra = {}) {
   Scene scene = dropScene(3, method, 0.012, extra);
@@ -169,10 +186,17 @@ Scene boxDropScene(const std::string& method, const std::vector<std::string>& ex
 void expectRoundWithinTwoPercent(const Scene& scene, const std::string& name, const std::vector<int>& frames) {
   const fs::path dir = runScene(scene, name);
   for (const int frame : frames) {
+    const std::vector<Eigen::Vector3f> positions = readParticlePly(framePath(dir, "particles", frame, "ply")).position;
     std::vector<Vec<3>> x;
-    for (const auto& p : readParticlePly(framePath(dir, "particles", frame, "ply")).position) x.push_back(p);
-    const double value = anisotropy<3>(x);
-    std::printf("frame %d: anisotropy %.4f\n", frame, value);
+    std::vector<Vec<2>> flat;
+    for (const auto& p : positions) {
+      if (scene.dimensions == 3)
+        x.push_back(p);
+      else
+        flat.push_back(p.head<2>());
+    }
+    const double value = scene.dimensions == 3 ? anisotropy<3>(x) : anisotropy<2>(flat);
+    std::printf("%s, frame %d: anisotropy %.4f\n", name.c_str(), frame, value);
     EXPECT_LT(value, 0.02) << "frame " << frame;
   }
 }
@@ -219,6 +243,21 @@ TEST(SurfaceTension, AViscousBoxDropRoundsToWithinTwoPercentInPbf3D) {
   Scene scene = boxDropScene("pbf", {"fluids[0].viscosity=2e-4"});
   scene.output.frames = 60;
   expectRoundWithinTwoPercent(scene, "viscous_box_drop_pbf", {30, 45, 60});
+}
+
+// In 2D the 2% holds with a kernel of 3 spacings' support (solver.kernel_radius 3 mm) in every method,
+// for a viscous drop (nu = 2e-4 m^2/s, as PBF's 3D box above): the 30 x 15 rectangle (R = 12 mm as a circle) at 1,
+// 1.5 and 2 s. Measured DFSPH 0.9%, 0.8%, 0.5%; WCSPH 1.3%, 0.9%, 0.6%; PBF 1.3%, 1.6%, 1.5%. At the default
+// support of 2 spacings the square lattice re-packs into a hexagonal crystal that holds the rectangle's shape
+// (DFSPH 0.56 viscous, 0.60 as water; WCSPH 0.53, PBF 0.12) and the test fails (docs/surface-tension.md, "A wider kernel").
+TEST(SurfaceTension, AViscousRectangleRoundsToWithinTwoPercentIn2DWithAWiderKernel) {
+  for (const std::string method : {"dfsph", "wcsph", "pbf"}) {
+    Scene scene = dropScene(2, method, 0.012, {"solver.kernel_radius=0.003", "fluids[0].viscosity=2e-4"});
+    scene.fluids[0].box.min = Eigen::Vector3d(-0.015, -0.0075, 0);
+    scene.fluids[0].box.max = Eigen::Vector3d(0.015, 0.0075, 0);
+    scene.output.frames = 60;
+    expectRoundWithinTwoPercent(scene, "viscous_rectangle_" + method, {30, 45, 60});
+  }
 }
 
 // Surface tension keeps a run's bytes the same at any thread count, and a resumed run ends where an uninterrupted
