@@ -68,8 +68,7 @@ void viscousDragNote(const Scene& scene, std::vector<std::string>& notes) {
                     "meets it within 10% at short steps (docs/viscosity.md)");
     return;
   }
-  double nu = 0;
-  for (size_t f = 0; f < scene.fluids.size(); ++f) nu = std::max(nu, fluidViscosity(scene, f));
+  const double nu = largestViscosity(scene);
   const double step = scene.solver.time_step > 0 ? scene.solver.time_step
                                                  : 1 / (scene.output.fps * std::max(1, scene.solver.substeps));
   const double ratio = nu * step / (a * a);

@@ -32,6 +32,23 @@ bool sceneHasViscosity(const Scene& scene) {
   return false;
 }
 
+double largestViscosity(const Scene& scene) {
+  double most = 0;
+  for (size_t f = 0; f < scene.fluids.size(); ++f) most = std::max(most, fluidViscosity(scene, f));
+  return most;
+}
+
+// The strain's pair blocks (d + 2) x^ x^^T are at most d + 2 times the component-wise identity, and so is its
+// operator's largest eigenvalue: a step that bound shorter is as stable (WCSPH's explicit honey rope diverged at
+// Morris's).
+float explicitViscosityStep(const Scene& scene, float support) {
+  const float smoothing = 0.5f * support;
+  float most = 0;
+  for (size_t f = 0; f < scene.fluids.size(); ++f) most = std::max(most, static_cast<float>(fluidViscosity(scene, f)));
+  const bool strain = scene.solver.viscosity_operator == "strain";
+  return 0.125f * smoothing * smoothing / most / (strain ? scene.dimensions + 2 : 1);
+}
+
 bool implicitViscosity(const Scene& scene) {
   const std::string& chosen = scene.solver.viscosity_solver;
   return chosen == "default" ? scene.solver.method != "wcsph" : chosen == "implicit";
@@ -51,15 +68,8 @@ Viscosity<Dim>::Viscosity(const Scene& scene, float support) {
   scale_ = 2.0f * latticeVolume<Dim>(spacing, kernel_);  // 2 V of the component-wise Laplacian
   maxError_ = static_cast<float>(scene.solver.viscosity_max_error);
   maxIterations_ = scene.solver.viscosity_max_iterations;
-  float most = 0;
-  for (size_t f = 0; f < scene.fluids.size(); ++f) {
-    nu_.push_back(static_cast<float>(fluidViscosity(scene, f)));
-    most = std::max(most, nu_.back());
-  }
-  // The strain's pair blocks (d + 2) x^ x^^T are at most d + 2 times the component-wise identity, and so is its
-  // operator's largest eigenvalue: a step that bound shorter is as stable (WCSPH's explicit honey rope diverged
-  // at Morris's).
-  if (!implicit_) stableStep_ = 0.125f * smoothing * smoothing / most / (strain_ ? Dim + 2 : 1);
+  for (size_t f = 0; f < scene.fluids.size(); ++f) nu_.push_back(static_cast<float>(fluidViscosity(scene, f)));
+  if (!implicit_) stableStep_ = explicitViscosityStep(scene, support);
   wallKeepTangent_ = static_cast<float>(1 - scene.viscous_slip);
   for (const ColliderSettings& c : scene.colliders) keepTangent_.push_back(static_cast<float>(1 - c.viscous_slip));
   for (const BodySettings& b : scene.bodies) keepTangent_.push_back(static_cast<float>(1 - b.solid.viscous_slip));

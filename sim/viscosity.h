@@ -53,8 +53,13 @@ namespace surge {
 double fluidViscosity(const Scene& scene, size_t block);
 // True if some fluid has a viscosity.
 bool sceneHasViscosity(const Scene& scene);
+// The largest of the fluids' nu (0 without viscosity).
+double largestViscosity(const Scene& scene);
 // solver.viscosity_solver: implicit, explicit, or by default explicit for WCSPH and implicit for the others.
 bool implicitViscosity(const Scene& scene);
+// The explicit solve's step limit with a kernel of this support: 0.125 (h/2)^2 / nu for the largest nu, d + 2
+// times shorter with the strain's operator (Viscosity::stableStep when explicit, and WCSPH's note).
+float explicitViscosityStep(const Scene& scene, float support);
 
 template <int Dim>
 class Viscosity {

@@ -51,13 +51,10 @@ std::vector<std::string> wcsphNotes(const Scene& scene) {
                       "energy back as motion (the energy account credits it in frame 1's source_work)");
       break;
     }
-  double nu = 0;
-  for (size_t f = 0; f < scene.fluids.size(); ++f) nu = std::max(nu, fluidViscosity(scene, f));
-  if (nu > 0 && !implicitViscosity(scene)) {
+  if (sceneHasViscosity(scene) && !implicitViscosity(scene)) {
     const SolverSettings& s = scene.solver;
-    const double half = 0.5 * s.kernel_radius;
-    const double viscous = 0.125 * half * half / nu / (s.viscosity_operator == "strain" ? scene.dimensions + 2 : 1);
-    const double sound = s.cfl * half / s.speed_of_sound;
+    const double viscous = explicitViscosityStep(scene, static_cast<float>(s.kernel_radius));
+    const double sound = s.cfl * 0.5 * s.kernel_radius / s.speed_of_sound;
     if (viscous < 0.25 * sound) {
       char text[320];
       std::snprintf(text, sizeof text,
