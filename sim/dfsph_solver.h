@@ -65,6 +65,7 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   float maxPressure() const override { return framePressureMax_; }
   // Each particle's pressure in the last step's density solve, rho_0 lambda_i / dt^2, in the current order.
   std::vector<float> pressures() const;
+  std::vector<float> virialPressures() override { return this->pairVirialPressures(kernel_, pressures(), {}); }
 
  private:
   using Core = ParticleSolver<Dim>;

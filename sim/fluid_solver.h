@@ -92,6 +92,10 @@ class FluidSolver {
   // The implicit viscosity solve's iterations in the last step (0 explicit), or -1 without viscosity.
   virtual int lastViscosityIterations() const { return -1; }
   virtual float maxPressure() const { return NAN; }
+  // Each particle's mechanical pressure at the current positions: the virial of its pair forces, the method's
+  // pressure force and surface tension's, (1 / (2 d V_i)) sum_j x_ij . F_ij. Where cohesion holds the fluid, this
+  // is the pressure Laplace's law speaks of (docs/surface-tension.md). Empty for a method without pressures.
+  virtual std::vector<float> virialPressures() { return {}; }
   virtual PhaseTimes& phaseTimes() = 0;
   // The work the method's cohesive forces (surface tension, adhesion) did on the fluid since the last call (J):
   // surface energy turned into motion, which the energy account counts as a source's work.

@@ -227,6 +227,41 @@ void ParticleSolver<Dim>::restoreCarriedState(const std::vector<float>& state) {
 }
 
 template <int Dim>
+std::vector<float> ParticleSolver<Dim>::pairVirialPressures(const SphKernel<Dim>& kernel,
+                                                            const std::vector<float>& pressure,
+                                                            const std::vector<float>& density) {
+  const size_t n = x_.size();
+  NeighborLists lists;
+  grid_.findNeighbors(x_, kernel.radius(), lists);
+  std::vector<double> virial(n, 0.0);  // each particle's half of sum_j x_ij . F_ij
+  const auto rho = [&](size_t i) { return density.empty() ? restDensity_ : density[i]; };
+  const auto massOf = [&](size_t i) { return massRatio_.empty() ? mass_ : mass_ * massRatio_[i]; };
+  kernel.visit([&](const auto& w) {
+    periodic_.withNearestImage([&](const auto& sharedWrap) {
+      parallelFor(0, n, [&](size_t b, size_t e) {
+        const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
+        for (size_t i = b; i < e; ++i) {
+          const float termI = pressure[i] / (rho(i) * rho(i));
+          double sum = 0;
+          for (const uint32_t* j = lists.begin(i); j != lists.end(i); ++j) {
+            VecD r = x_[i] - x_[*j];
+            wrap(r);
+            const float force = -massOf(i) * massOf(*j) * (termI + pressure[*j] / (rho(*j) * rho(*j))) *
+                                w.gradientFactor(r.norm());  // F_ij / |x_ij| . x_ij / |x_ij| ...
+            sum += double(force) * double(r.squaredNorm());  // ... so x_ij . F_ij
+          }
+          virial[i] = 0.5 * sum;
+        }
+      });
+    });
+  });
+  if (tension_.active()) tension_.addPairVirials(x_, lists, fluid_, virial);
+  std::vector<float> result(n);
+  for (size_t i = 0; i < n; ++i) result[i] = float(virial[i] * rho(i) / (Dim * massOf(i)));
+  return result;
+}
+
+template <int Dim>
 size_t ParticleSolver<Dim>::coreMemoryBytes() const {
   size_t bytes = (x_.capacity() + v_.capacity() + vectorScratch_.capacity()) * sizeof(VecD);
   bytes += (id_.capacity() + idScratch_.capacity()) * sizeof(uint32_t) + floatScratch_.capacity() * sizeof(float);

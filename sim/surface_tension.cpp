@@ -228,25 +228,20 @@ double SurfaceTension<Dim>::tensionPerGamma(float spacing, float support, float 
 }
 
 template <int Dim>
-void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const NeighborLists& neighbors,
-                                               Colliders<Dim>& colliders, float impulseScale,
-                                               const std::vector<uint8_t>& fluid) {
+template <bool kSeveral, typename Wrap>
+void SurfaceTension<Dim>::colourAndNormals(const std::vector<VecD>& x, const NeighborLists& neighbors,
+                                           const std::vector<uint8_t>& fluid, const Wrap& sharedWrap) {
   const size_t n = x.size();
-  accel_.resize(n);
   colour_.resize(n);
   normal_.resize(n);
   const float self = volume_ * kernel_.value(0);
-  // One fluid compiles without the fluid checks (its loops as they were before several fluids).
-  const auto passes = [&](auto severalFluids) {
-  constexpr bool several = decltype(severalFluids)::value;
-  periodic_.withNearestImage([&](const auto& sharedWrap) {
   parallelFor(0, n, [&](size_t b, size_t e) {
     const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     for (size_t i = b; i < e; ++i) {
       float c = self;
       VecD normal = VecD::Zero();
       for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
-        if (several && fluid[*j] != fluid[i]) continue;  // another fluid counts as air
+        if (kSeveral && fluid[*j] != fluid[i]) continue;  // another fluid counts as air
         VecD r = x[i] - x[*j];
         wrap(r);
         const SphKernelPair k = kernel_.pair(r.norm());
@@ -257,7 +252,49 @@ void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const
       normal_[i] = (support_ * volume_) * normal;
     }
   });
-  const float tiny = 1e-6f * support_;
+}
+
+template <int Dim>
+void SurfaceTension<Dim>::addPairVirials(const std::vector<VecD>& x, const NeighborLists& neighbors,
+                                         const std::vector<uint8_t>& fluid, std::vector<double>& virial) {
+  const auto passes = [&](auto severalFluids) {
+    constexpr bool several = decltype(severalFluids)::value;
+    periodic_.withNearestImage([&](const auto& sharedWrap) {
+      colourAndNormals<several>(x, neighbors, fluid, sharedWrap);
+      parallelFor(0, x.size(), [&](size_t b, size_t e) {
+        const auto wrap = sharedWrap;
+        for (size_t i = b; i < e; ++i) {
+          const size_t f = several ? fluid[i] : 0;
+          const float m = fluidMass_[f];
+          double sum = 0;
+          for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
+            if (several && fluid[*j] != f) continue;
+            VecD r = x[i] - x[*j];
+            wrap(r);
+            sum += double(r.dot(pairTerm(i, *j, r, m)));  // x_ij . a_ij / gamma
+          }
+          virial[i] += 0.5 * sum * fluidGamma_[f] * m;
+        }
+      });
+    });
+  };
+  if (fluid.empty())
+    passes(std::false_type{});
+  else
+    passes(std::true_type{});
+}
+
+template <int Dim>
+void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const NeighborLists& neighbors,
+                                               Colliders<Dim>& colliders, float impulseScale,
+                                               const std::vector<uint8_t>& fluid) {
+  const size_t n = x.size();
+  accel_.resize(n);
+  // One fluid compiles without the fluid checks (its loops as they were before several fluids).
+  const auto passes = [&](auto severalFluids) {
+  constexpr bool several = decltype(severalFluids)::value;
+  periodic_.withNearestImage([&](const auto& sharedWrap) {
+  colourAndNormals<several>(x, neighbors, fluid, sharedWrap);
   parallelFor(0, n, [&](size_t b, size_t e) {
     const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
     for (size_t i = b; i < e; ++i) {
@@ -268,10 +305,7 @@ void SurfaceTension<Dim>::computeAccelerations(const std::vector<VecD>& x, const
         if (several && fluid[*j] != f) continue;
         VecD r = x[i] - x[*j];
         wrap(r);
-        const float length = r.norm();
-        VecD pair = normal_[*j] - normal_[i];  // eq. 4
-        if (length > tiny) pair -= (m * cohesion(length) / length) * r;  // eq. 1
-        a += (2.0f / (colour_[i] + colour_[*j])) * pair;  // eq. 6's K_ij
+        a += pairTerm(i, *j, r, m);
       }
       a *= fluidGamma_[f];
       if (adhesive_)

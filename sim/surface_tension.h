@@ -73,6 +73,11 @@ class SurfaceTension {
     return w;
   }
   size_t memoryBytes() const;
+  // Adds to `virial` each particle's half of the virial of the model's pair forces at x, (1/2) sum_j x_ij . m
+  // a_ij (cohesion and curvature; adhesion left out): the model's share of the mechanical pressure
+  // (FluidSolver::virialPressures). Overwrites the colour and normals the accelerations were computed with.
+  void addPairVirials(const std::vector<VecD>& x, const NeighborLists& neighbors, const std::vector<uint8_t>& fluid,
+                      std::vector<double>& virial);
 
   // Kirkwood and Buff: sigma = (1 / 4A) sum_i sum_j (r_n F_n - r_t F_t) over the pairs of a column of a slab of
   // the rest lattice with two free faces (A the column's area, n across the slab, t along it), for gamma = 1.
@@ -84,6 +89,17 @@ class SurfaceTension {
  private:
   PeriodicDomain<Dim> periodic_;  // domain.periodic: pairs take their nearest image
   float cohesion(float r) const;  // C(r) of eq. 2
+  // colour_ and normal_ at x (eq. 5), counting the particle's own fluid only with several.
+  template <bool kSeveral, typename Wrap>
+  void colourAndNormals(const std::vector<VecD>& x, const NeighborLists& neighbors, const std::vector<uint8_t>& fluid,
+                        const Wrap& sharedWrap);
+  // Particle i's pair term from j at offset r, before gamma: K_ij ((n_j - n_i) - m C(|r|) r / |r|) (eq. 6, 4, 1).
+  VecD pairTerm(size_t i, size_t j, const VecD& r, float m) const {
+    const float length = r.norm();
+    VecD pair = normal_[j] - normal_[i];                                            // eq. 4
+    if (length > 1e-6f * support_) pair -= (m * cohesion(length) / length) * r;  // eq. 1
+    return (2.0f / (colour_[i] + colour_[j])) * pair;                              // eq. 6's K_ij
+  }
   float wallAdhesion(float d) const;  // sum_b V A(|x - x_b|) along the normal, a wall at d (table)
 
   CubicSplineKernel<Dim> kernel_{1.0f};

@@ -61,6 +61,7 @@ class WcsphSolver final : public ParticleSolver<Dim> {
   double compressionEnergy() override;
   // Pressures of the last evaluation, in the particles' current order (for tests).
   const std::vector<float>& pressures() const { return pressure_; }
+  std::vector<float> virialPressures() override { return this->pairVirialPressures(kernel_, pressure_, density_); }
 
  private:
   using Core = ParticleSolver<Dim>;

@@ -1,5 +1,5 @@
 // Surface tension (sim/surface_tension.h) against the physics: a drop in zero gravity rounds, oscillates at
-// Rayleigh's frequency and holds Laplace's pressure, in every method, 2D and 3D.
+// Rayleigh's frequency and holds Laplace's pressure, in every method, 2D and 3D, where the model does.
 #include "sim/surface_tension.h"
 
 #include <gtest/gtest.h>
@@ -172,6 +172,46 @@ TEST(SurfaceTension, AThreeDimensionalDropOscillatesAtRayleighsFrequencyInDfsphW
   ASSERT_EQ(crossings.size(), 5u) << "the drop did not oscillate";
   EXPECT_NEAR(crossings[0] / half, 1.0, 0.1);
   EXPECT_NEAR((crossings[4] - crossings[0]) / 4 / half, 1.0, 0.1);
+}
+
+// Laplace: a drop at rest holds a pressure (d - 1) sigma / R above the air's. The solver's own pressure holds the
+// fluid against the cohesion's pull, of order sigma / h, so the pressure Laplace's law speaks of is the mechanical
+// one, the virial of every pair force (FluidSolver::virialPressures). DFSPH 3D with 2.5 spacings of support, R = 16
+// mm (32 particles across), the particles within R/2 over 0.2 s: within the 10% of 2 sigma / R (measured
+// 1.06 by a probe; 1.18, 1.17, 1.13 at 8, 10, 12 mm and 1.05 at 20: the excess falls as 1/R, docs/surface-tension.md).
+// Over the whole drop the virial of a system at rest sums to zero: held to a tenth of Laplace's, so that the
+// interior's figure is not an offset of the measure.
+TEST(SurfaceTension, ADropsInnerPressureIsLaplacesInDfsphWithAWiderKernel) {
+  const double radius = 0.02, laplace = 2 * kSigma / radius;
+  auto solver = makeFluidSolver<3>(dropScene(3, "dfsph", radius, {"solver.kernel_radius=0.0025"}));
+  relaxDrop<3>(*solver, radius, 0.3);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  double time = 0, inside = 0, whole = 0;
+  long insideCount = 0, wholeCount = 0;
+  for (int sample = 0; sample < 20; ++sample) {
+    stepFor<3>(*solver, time, 0.01, 1.0 / 120);
+    ASSERT_FALSE(::testing::Test::HasFatalFailure());
+    const std::vector<float> pressure = solver->virialPressures();
+    const auto& x = solver->positions();
+    ASSERT_EQ(pressure.size(), x.size());
+    Vec<3> centre = Vec<3>::Zero();
+    for (const auto& p : x) centre += p;
+    centre /= float(x.size());
+    for (size_t i = 0; i < x.size(); ++i) {
+      if ((x[i] - centre).norm() < radius / 2) {
+        inside += pressure[i];
+        ++insideCount;
+      }
+      whole += pressure[i];
+      ++wholeCount;
+    }
+  }
+  inside /= double(insideCount);
+  whole /= double(wholeCount);
+  std::printf("inside %.3f Pa (%.3f of 2 sigma / R = %.3f Pa), the whole drop's mean %.3f Pa\n", inside,
+              inside / laplace, laplace, whole);
+  EXPECT_NEAR(inside / laplace, 1.0, 0.1);
+  EXPECT_LT(std::abs(whole), 0.1 * laplace);
 }
 
 // The 2:1:1 box of water (24 x 12 x 12 particles at 1 mm) in zero gravity, in `method`.
