@@ -218,6 +218,17 @@ std::vector<std::string> solverNotes(const Scene& scene) {
   if (sceneHasAdhesion(scene) && sceneSurfaceTension(scene) == 0)
     notes.push_back("adhesion is set on a collider or body, but the fluid has no surface_tension: adhesion is a "
                     "share of the fluid's cohesion and does nothing without it");
+  // In 2D, cohesion over 2 spacings of support holds the lattice as a crystal (docs/surface-tension.md).
+  if (scene.dimensions == 2 && sceneSurfaceTension(scene) > 0 &&
+      scene.solver.kernel_radius < 2.75 * scene.particle_spacing) {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "surface tension in 2D with %.3g spacings of kernel support holds the particles as a crystal: a drop "
+                  "keeps its shape instead of rounding; solver.kernel_radius %g (3 spacings) lets it flow "
+                  "(docs/surface-tension.md)",
+                  scene.solver.kernel_radius / scene.particle_spacing, 3 * scene.particle_spacing);
+    notes.push_back(text);
+  }
   // The transport velocity pushes particles out of a free surface.
   if (scene.solver.background_pressure > 0) {
     double tank = 1;
