@@ -177,7 +177,8 @@ class ParticleSolver : public FluidSolver<Dim> {
     return firstParticleOutside(x_, v_, walls_, speedLimit_);
   }
   // virialPressures for a method whose pressure force is -m_i m_j (p_i / rho_i^2 + p_j / rho_j^2) grad W_ij
-  // (`density` empty: rho_0 for every particle), over neighbour lists of its own at x_; adhesion left out.
+  // (`density` empty: rho_0 for every particle), over neighbour lists of its own at x_; adhesion left out. With
+  // several fluids DFSPH weights its pressure force by its density contrast, so there the figure is approximate.
   std::vector<float> pairVirialPressures(const SphKernel<Dim>& kernel, const std::vector<float>& pressure,
                                          const std::vector<float>& density);
   // Bytes held by the shared channels, the grid, the lists and the colliders (capacities).

@@ -221,12 +221,15 @@ std::vector<std::string> solverNotes(const Scene& scene) {
   // In 2D, cohesion over 2 spacings of support holds the lattice as a crystal (docs/surface-tension.md).
   if (scene.dimensions == 2 && sceneSurfaceTension(scene) > 0 &&
       scene.solver.kernel_radius < 2.75 * scene.particle_spacing) {
-    char text[320];
+    char text[400];
     std::snprintf(text, sizeof text,
                   "surface tension in 2D with %.3g spacings of kernel support holds the particles as a crystal: a drop "
-                  "keeps its shape instead of rounding; solver.kernel_radius %g (3 spacings) lets it flow "
+                  "keeps its shape instead of rounding; solver.kernel_radius %g (3 spacings) lets it flow%s "
                   "(docs/surface-tension.md)",
-                  scene.solver.kernel_radius / scene.particle_spacing, 3 * scene.particle_spacing);
+                  scene.solver.kernel_radius / scene.particle_spacing, 3 * scene.particle_spacing,
+                  scene.solver.method == "pbf" ? ", with a viscosity (fluids[i].viscosity) in PBF, whose drops gain "
+                                                 "energy from the curvature force without one"
+                                               : "");
     notes.push_back(text);
   }
   // The transport velocity pushes particles out of a free surface.
