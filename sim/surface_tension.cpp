@@ -65,9 +65,12 @@ double surfaceEnergyBound(const Scene& scene, const ParticleFrame& initial) {
   if (!scene.emitters.empty()) return INFINITY;
   const double spacing = scene.particle_spacing;
   const int dim = scene.dimensions;
+  // A block's sites sit at cell centres or, when its edges fall half a spacing off the domain's grid, on cell
+  // corners, where floor() would part rounding errors into two cells; a quarter spacing more keeps either lattice
+  // (and a jittered start's sites, at most a quarter spacing off theirs) one site a cell.
   auto cell = [&](const Eigen::Vector3f& p) {
     Eigen::Vector3i c = Eigen::Vector3i::Zero();
-    for (int k = 0; k < dim; ++k) c[k] = int(std::floor((double(p[k]) - scene.domain.min[k]) / spacing));
+    for (int k = 0; k < dim; ++k) c[k] = int(std::floor((double(p[k]) - scene.domain.min[k]) / spacing + 0.25));
     return c;
   };
   auto key = [](const Eigen::Vector3i& c) {
