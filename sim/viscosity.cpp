@@ -43,8 +43,7 @@ double largestViscosity(const Scene& scene) {
 // Morris's).
 float explicitViscosityStep(const Scene& scene, float support) {
   const float smoothing = 0.5f * support;
-  float most = 0;
-  for (size_t f = 0; f < scene.fluids.size(); ++f) most = std::max(most, static_cast<float>(fluidViscosity(scene, f)));
+  const float most = static_cast<float>(largestViscosity(scene));  // the rounding keeps the order: the floats' max
   const bool strain = scene.solver.viscosity_operator == "strain";
   return 0.125f * smoothing * smoothing / most / (strain ? scene.dimensions + 2 : 1);
 }
