@@ -190,8 +190,16 @@ template <int Dim>
 float ParticleSolver<Dim>::depthStableStepNow() {
   const float g = gravity_.norm();
   if (!(g > 0) || size() == 0) return INFINITY;
-  columnCounts_.assign(size_t(columns_.prod()), 0);
-  for (const VecD& p : x_) {
+  const size_t cells = size_t(columns_.prod());
+  columnCounts_.assign(cells, 0);
+  const bool several = !massRatio_.empty();
+  if (several) {
+    columnMass_.assign(cells, 0.0f);
+    columnBottom_.assign(cells, {-INFINITY, 1.0f});
+  }
+  const float downward = gravity_[down_] < 0 ? -1.0f : 1.0f;  // a particle's depth along gravity is downward p
+  for (size_t i = 0; i < size(); ++i) {
+    const VecD& p = x_[i];
     size_t cell = 0;
     for (int k = Dim - 1; k >= 0; --k) {
       if (k == down_) continue;
@@ -199,9 +207,19 @@ float ParticleSolver<Dim>::depthStableStepNow() {
       cell = cell * size_t(columns_[k]) + size_t(c);
     }
     ++columnCounts_[cell];
+    if (several) {
+      columnMass_[cell] += massRatio_[i];
+      const float depth = downward * p[down_];
+      if (depth > columnBottom_[cell].first) columnBottom_[cell] = {depth, massRatio_[i]};
+    }
   }
-  const uint32_t most = *std::max_element(columnCounts_.begin(), columnCounts_.end());
-  const float deepest = float(most) * std::pow(latticeSpacing_, float(Dim)) / columnArea_;
+  // With several fluids, the column's weight held by the fluid at its bottom, in that fluid's own depth: a light
+  // layer under a heavy one is pressed as a pool of the light fluid as deep as the column's weight.
+  float most = 0;
+  for (size_t c = 0; c < cells; ++c)
+    most = std::max(most, several ? std::max(float(columnCounts_[c]), columnMass_[c] / columnBottom_[c].second)
+                                  : float(columnCounts_[c]));
+  const float deepest = most * std::pow(latticeSpacing_, float(Dim)) / columnArea_;
   return static_cast<float>(depthStableStep(latticeSpacing_, g, deepest));
 }
 

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <utility>
 #include <memory>
 #include <vector>
 
@@ -163,7 +164,8 @@ class ParticleSolver : public FluidSolver<Dim> {
   float fastestAfterFall(float dt);
   // stableSubsteps's depth criterion on the deepest column as the fluid stands now, dt <= 0.9 spacing /
   // sqrt(|g| depth) (infinity without gravity or particles): a dam break's column is deeper at the start than
-  // the pool it settles into.
+  // the pool it settles into. With several fluids a column's depth is at least its weight over its bottom
+  // particle's density (a light layer under a heavy one).
   float depthStableStepNow();
   // The fluid-filled box's shared parts (DFSPH's and PBF's): the density target of a domain periodic along every
   // axis, the mean of `densityRatio` (rho_i / rho_0) when above 1; and the step the transport velocity's push
@@ -241,7 +243,8 @@ class ParticleSolver : public FluidSolver<Dim> {
 
   // The deepest column (depthStableStepNow): the particles counted on a grid over the tank's floor, its cells
   // kColumnSpacings spacings across; a column's depth is its particles' volume over its cell's area (a pool's
-  // depth in a pool, a thin jet's little).
+  // depth in a pool, a thin jet's little). With several fluids, a column also weighs its particles' mass ratios and
+  // keeps its bottom particle's (its depth along gravity, its ratio).
   static constexpr float kColumnSpacings = 4;
   float latticeSpacing_ = 0;
   int down_ = 1;                      // the axis gravity is mostly along
@@ -249,6 +252,8 @@ class ParticleSolver : public FluidSolver<Dim> {
   float columnArea_ = 1;              // a cell's area across the down axis (its length in 2D)
   Eigen::Matrix<int, Dim, 1> columns_;
   std::vector<uint32_t> columnCounts_;
+  std::vector<float> columnMass_;
+  std::vector<std::pair<float, float>> columnBottom_;
 
   std::vector<std::vector<float>> carriedHold_;  // editParticles: the carried channels while the rest resize
   float sceneSpeedLimit_;  // runawaySpeed(scene)
