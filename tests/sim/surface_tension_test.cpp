@@ -445,6 +445,25 @@ TEST(SurfaceTension, SurgeSimSaysA2DDropAtTheDefaultSupportKeepsItsShape) {
   EXPECT_NE(pbf[0].find("viscosity"), std::string::npos) << pbf[0];
 }
 
+// The adhesion's calibration holds at 2 spacings of support (the test above), not at 2.5 or 3: surge sim says so
+// where a scene with adhesion and surface tension has another support.
+TEST(SurfaceTension, SurgeSimSaysTheAdhesionIsCalibratedAtTwoSpacings) {
+  auto adhesionNotes = [](const std::vector<std::string>& extra) {
+    std::string json = R"({"name": "plate", "dimensions": 3, "domain": {"min": [-0.02, -0.006, -0.02],
+        "max": [0.02, 0.03, 0.02]}, "particle_spacing": 0.001, "gravity": [0, 0, 0], "solver": {"method": "dfsph"},
+        "fluids": [{"box": {"min": [-0.006, 0, -0.006], "max": [0.006, 0.012, 0.006]}, "surface_tension": 0.0728}],
+        "colliders": [{"shape": "box", "position": [0, -0.003, 0], "size": [0.04, 0.006, 0.04]}]})";
+    int count = 0;
+    for (const std::string& note : solverNotes(parseScene(json, "plate.json", extra)))
+      count += note.find("adhesion is calibrated at 2 spacings") != std::string::npos;
+    return count;
+  };
+  EXPECT_EQ(adhesionNotes({"colliders[0].adhesion=0.5"}), 0);
+  EXPECT_EQ(adhesionNotes({"colliders[0].adhesion=0.5", "solver.kernel_radius=0.0025"}), 1);
+  EXPECT_EQ(adhesionNotes({"colliders[0].adhesion=0.5", "solver.kernel_radius=0.003"}), 1);
+  EXPECT_EQ(adhesionNotes({"solver.kernel_radius=0.0025"}), 0);
+}
+
 // Bad input: one line naming the key.
 TEST(SurfaceTension, BadInputIsRefusedNamingTheKey) {
   auto message = [](const std::vector<std::string>& overrides) {
