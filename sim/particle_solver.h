@@ -11,8 +11,8 @@
 
 #include <algorithm>
 #include <functional>
-#include <utility>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "core/ply.h"

@@ -221,14 +221,10 @@ std::vector<std::string> solverNotes(const Scene& scene) {
   // The adhesion's calibration holds at 2 spacings of support, not at 2.5 or 3 (docs/surface-tension.md).
   const double support = scene.solver.kernel_radius / scene.particle_spacing;
   if (sceneHasAdhesion(scene) && sceneSurfaceTension(scene) > 0 && std::abs(support - 2) > 0.05) {
-    char text[400];
-    std::snprintf(text, sizeof text,
-                  "adhesion is calibrated at 2 spacings of kernel support (contact angles 122, 91, 70 degrees at "
-                  "adhesion 0.25, 0.5, 0.75, Young's 120, 90, 60); with %.3g spacings it may not give Young's angle: "
-                  "measured, 2.5 wets more (104 and 69 degrees at 0.25 and 0.5, a film at 0.75) and 3 less (118, 101, "
-                  "84) (docs/surface-tension.md)",
-                  support);
-    notes.push_back(text);
+    notes.push_back("adhesion is calibrated at 2 spacings of kernel support (contact angles 122, 91, 70 degrees at "
+                    "adhesion 0.25, 0.5, 0.75, Young's 120, 90, 60); with " + threeFigures(support) +
+                    " spacings it may not give Young's angle: measured, 2.5 wets more (104 and 69 degrees at 0.25 and "
+                    "0.5, a film at 0.75) and 3 less (118, 101, 84) (docs/surface-tension.md)");
   }
   // In 2D, cohesion over 2 spacings of support holds the lattice as a crystal (docs/surface-tension.md).
   if (scene.dimensions == 2 && sceneSurfaceTension(scene) > 0 &&
