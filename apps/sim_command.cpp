@@ -89,6 +89,15 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   if (summary.removedParticles > 0)
     say(options, "sim: removed " + std::to_string(summary.removedParticles) +
                      " fluid particles placed inside " + (scene.bodies.empty() ? "colliders" : "colliders and bodies"));
+  // A density solver that stopped at its cap left the density error above solver.max_density_error there.
+  if (summary.cappedSteps > 0)
+    say(options, "sim: the density solver stopped at its cap of " + std::to_string(summary.iterationCap) +
+                     " iterations in " + std::to_string(summary.cappedSteps) + " of " + std::to_string(summary.steps) +
+                     " steps (frames " + std::to_string(summary.firstCappedFrame) + "-" +
+                     std::to_string(summary.lastCappedFrame) +
+                     "), short of solver.max_density_error there (stats.csv's density_error_avg); more "
+                     "solver.substeps or " + (scene.solver.method == "pbf" ? "solver.iterations" : "solver.max_iterations") +
+                     " let it converge");
   char line[256];
   std::snprintf(line, sizeof line, "sim: %zu particles, frames %d-%d in %.1f s -> %s/particles",
                 summary.particles, summary.firstFrame, summary.lastFrame, summary.wallSeconds,

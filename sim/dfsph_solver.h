@@ -60,6 +60,7 @@ class DfsphSolver final : public ParticleSolver<Dim> {
 
   FluidMeasures measure() override;
   int lastIterations() const override { return densityIterations_; }
+  int densityIterationCap() const override { return maxIterations_; }
   int lastDivergenceIterations() const override { return divergenceIterations_; }
   // The largest pressure of the frame's density solves, p_i = rho_0 lambda_i / dt^2.
   float maxPressure() const override { return framePressureMax_; }

@@ -88,6 +88,9 @@ class FluidSolver {
   // method without pressures) and the time spent per phase.
   virtual FluidMeasures measure() = 0;
   virtual int lastIterations() const = 0;
+  // The most density iterations a step may take where the method iterates to solver.max_density_error (a step
+  // that takes them all stopped short of it); 0 for a method that takes a fixed count or none.
+  virtual int densityIterationCap() const { return 0; }
   virtual int lastDivergenceIterations() const { return -1; }
   // The implicit viscosity solve's iterations in the last step (0 explicit), or -1 without viscosity.
   virtual int lastViscosityIterations() const { return -1; }

@@ -56,6 +56,7 @@ class PbfSolver final : public ParticleSolver<Dim> {
 
   FluidMeasures measure() override;
   int lastIterations() const override { return lastIterations_; }
+  int densityIterationCap() const override { return maxDensityError_ > 0 ? iterations_ : 0; }
   // Bytes held by every particle channel, the grid, the neighbour lists and the pair factors (capacities).
   size_t memoryBytes() const;
 

@@ -262,6 +262,11 @@ class FrameLoop final : public SimulationRun {
                        ": body " + scene_.bodies[badBody].solid.name + " (its state is not finite)");
       smallestStep = std::min(smallestStep, dt);
       iterations += solver.lastIterations();
+      if (solver.densityIterationCap() > 0 && solver.lastIterations() >= solver.densityIterationCap()) {
+        if (summary_.cappedSteps++ == 0) summary_.firstCappedFrame = f;
+        summary_.lastCappedFrame = f;
+        summary_.iterationCap = solver.densityIterationCap();
+      }
       divergenceIterations += solver.lastDivergenceIterations();
       viscosityIterations += solver.lastViscosityIterations();
       if (bad >= 0) {
@@ -280,6 +285,7 @@ class FrameLoop final : public SimulationRun {
     record_.measures = solver.measure();
     solver.getParticles(frame_);
     record_.steps = steps;
+    summary_.steps += size_t(steps);
     record_.iterations = double(iterations) / steps;
     record_.divergenceIterations = divergenceIterations < 0 ? NAN : double(divergenceIterations) / steps;
     record_.viscosityIterations = viscosityIterations < 0 ? NAN : double(viscosityIterations) / steps;

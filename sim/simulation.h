@@ -37,6 +37,10 @@ struct SimulationSummary {
   size_t particles = 0;
   size_t removedParticles = 0;  // fluid placed inside colliders, removed at set-up
   double wallSeconds = 0;
+  // The steps this run took, and those whose density solver stopped at its cap (FluidSolver::densityIterationCap)
+  // rather than at solver.max_density_error, with the first and last frame they fell in.
+  size_t steps = 0, cappedSteps = 0;
+  int iterationCap = 0, firstCappedFrame = 0, lastCappedFrame = 0;
 };
 
 // Simulates the scene into dir: particles/frame_NNNNN.ply for frames 0..output.frames and stats.csv.
