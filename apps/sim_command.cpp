@@ -7,6 +7,7 @@
 #include "core/errors.h"
 #include "core/parallel.h"
 #include "sim/rigid_bodies.h"
+#include "sim/fluid_solver.h"
 #include "sim/simulation.h"
 #include "sim/solver_defaults.h"
 
@@ -90,13 +91,14 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
     say(options, "sim: removed " + std::to_string(summary.removedParticles) +
                      " fluid particles placed inside " + (scene.bodies.empty() ? "colliders" : "colliders and bodies"));
   // A density solver that stopped at its cap left the density error above solver.max_density_error there.
-  if (summary.cappedSteps > 0)
+  const char* capKey = fluidMethod(scene.solver.method, scene.source).iterationCapKey;
+  if (summary.cappedSteps > 0 && capKey)
     say(options, "sim: the density solver stopped at its cap of " + std::to_string(summary.iterationCap) +
                      " iterations in " + std::to_string(summary.cappedSteps) + " of " + std::to_string(summary.steps) +
                      " steps (frames " + std::to_string(summary.firstCappedFrame) + "-" +
                      std::to_string(summary.lastCappedFrame) +
                      "), short of solver.max_density_error there (stats.csv's density_error_avg); more "
-                     "solver.substeps or " + (scene.solver.method == "pbf" ? "solver.iterations" : "solver.max_iterations") +
+                     "solver.substeps or " + capKey +
                      " let it converge");
   char line[256];
   std::snprintf(line, sizeof line, "sim: %zu particles, frames %d-%d in %.1f s -> %s/particles",

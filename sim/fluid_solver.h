@@ -137,6 +137,9 @@ struct FluidMethod {
   // False for a method whose emitters make energy the account cannot see, so that the energy stop leaves its runs
   // with emitters alone (WCSPH: a nozzle opening under water throws the pool about, docs/speed-accuracy.md).
   bool emittersAccounted = true;
+  // The key that caps its density iterations where it iterates to solver.max_density_error (FluidSolver::
+  // densityIterationCap), for surge sim's report and the energy stop's remedy; null for none.
+  const char* iterationCapKey = nullptr;
 };
 
 // FluidMethod::make2 and make3 for a solver class template.

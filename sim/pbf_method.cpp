@@ -74,6 +74,7 @@ std::vector<std::string> pbfNotes(const Scene& scene) {
 const FluidMethod kPbfMethod = {"pbf", "Position Based Fluids (Macklin & Mueller 2013)",
     &makeMethod<PbfSolver, 2>, &makeMethod<PbfSolver, 3>, 250, 400,
     &pbfPushesPerFrame, nullptr, &pbfNotes, &declarePbfKeys,
-    "more solver.substeps or solver.iterations (at many steps a frame, a smaller solver.scorr_k: its push is a step's)"};
+    "more solver.substeps or solver.iterations (at many steps a frame, a smaller solver.scorr_k: its push is a step's)",
+    true, "solver.iterations"};
 
 }  // namespace surge

@@ -321,8 +321,19 @@ class FrameLoop final : public SimulationRun {
     record_.potentialEnergy = potentialEnergy(scene_, frame_, solver.particleMass());
     record_.sourceWork = ledger_->sourceWork();
     if (record_.frame == 0) ledger_->start(record_.measures.kineticEnergy, record_.potentialEnergy);
-    else ledger_->check(record_.frame, record_.measures.kineticEnergy, record_.potentialEnergy,
-                        solver.particleMass() * double(frame_.size()));
+    else
+      try {
+        ledger_->check(record_.frame, record_.measures.kineticEnergy, record_.potentialEnergy,
+                       solver.particleMass() * double(frame_.size()));
+      } catch (const RunError& stop) {
+        // Where the density solver stopped at its cap, more iterations are the remedy too.
+        const char* key = fluidMethod(scene_.solver.method, scene_.source).iterationCapKey;
+        if (summary_.cappedSteps == 0 || !key) throw;
+        throw RunError(std::string(stop.what()) + "; its density solver stopped at its cap of " +
+                       std::to_string(summary_.iterationCap) + " iterations in " +
+                       std::to_string(summary_.cappedSteps) + " of " + std::to_string(summary_.steps) +
+                       " steps, where a larger " + key + " lets it converge");
+      }
     record_.carriedState = solver.carriedState();
     for (const std::unique_ptr<FrameOutput>& output : outputs_) output->write(record_);
   }

@@ -90,6 +90,19 @@ TEST(SimCommand, SaysWhereTheDensitySolverStoppedAtItsCap) {
   EXPECT_NE(pbf.find("solver.iterations let it converge"), std::string::npos) << pbf;
   const auto [fixed, fixedSteps] = run("", "surge_pbf_fixed");
   EXPECT_EQ(fixed.find("stopped at its cap"), std::string::npos) << fixed;
+  // A run the energy stop ends says so in its one line too: a column 1 m deep (10,000 particles at 1 cm) under
+  // DFSPH held to 3 iterations gains energy by frame 4.
+  const fs::path deep = writeTestScene("capped_column.json", R"({"name": "column", "dimensions": 2,
+      "domain": {"min": [0, 0], "max": [3.2, 1.6]}, "particle_spacing": 0.01,
+      "fluids": [{"box": {"min": [0, 0], "max": [1.0, 1.0]}}], "solver": {"method": "dfsph", "max_iterations": 3,
+      "max_density_error": 0.00001}, "output": {"fps": 30, "frames": 4}})");
+  const SurgeResult stopped = runSurge("sim '" + deep.string() + "' --out " + freshFolder("surge_capped_stop").string());
+  EXPECT_EQ(stopped.status, 1) << stopped.err;
+  EXPECT_NE(stopped.err.find("gained energy from nowhere"), std::string::npos) << stopped.err;
+  EXPECT_NE(stopped.err.find("; its density solver stopped at its cap of 3 iterations in "), std::string::npos)
+      << stopped.err;
+  EXPECT_NE(stopped.err.find("a larger solver.max_iterations lets it converge"), std::string::npos) << stopped.err;
+  EXPECT_EQ(std::count(stopped.err.begin(), stopped.err.end(), '\n'), 1) << stopped.err;
 }
 
 // fluids[i].velocity_field with a formula that parses but is not finite somewhere in its block (a square root of
