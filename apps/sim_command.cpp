@@ -93,13 +93,9 @@ void runSimStage(const Scene& scene, const fs::path& dir, bool resume, const Com
   // A density solver that stopped at its cap left the density error above solver.max_density_error there.
   const char* capKey = fluidMethod(scene.solver.method, scene.source).iterationCapKey;
   if (summary.cappedSteps > 0 && capKey)
-    say(options, "sim: the density solver stopped at its cap of " + std::to_string(summary.iterationCap) +
-                     " iterations in " + std::to_string(summary.cappedSteps) + " of " + std::to_string(summary.steps) +
-                     " steps (frames " + std::to_string(summary.firstCappedFrame) + "-" +
-                     std::to_string(summary.lastCappedFrame) +
-                     "), short of solver.max_density_error there (stats.csv's density_error_avg); more "
-                     "solver.substeps or " + capKey +
-                     " let it converge");
+    say(options, "sim: the density solver " + densityCapReport(summary) +
+                     ", short of solver.max_density_error there (stats.csv's density_error_avg); more solver.substeps "
+                     "or " + capKey + " let it converge");
   char line[256];
   std::snprintf(line, sizeof line, "sim: %zu particles, frames %d-%d in %.1f s -> %s/particles",
                 summary.particles, summary.firstFrame, summary.lastFrame, summary.wallSeconds,

@@ -144,11 +144,39 @@ uint32_t startParticles(const Scene& scene, const fs::path& dir, bool resume, Fl
   return scene.emitters.empty() ? 0 : static_cast<uint32_t>(initialParticles(scene).size());
 }
 
-// The frame loop, for any solver. Each step is the largest stable one (stableTimeStep) shortened so the steps
-// left end exactly on the frame: dt = remaining / ceil(remaining / stable). A solver with fixedSubsteps() > 0
-// takes that many equal steps a frame while the stable step is no shorter, which is then its longest (a frame
-// whose steps all meet the need runs as before the need was checked). Each frame's record goes to every
-// FrameOutput. The constructor sets the run up and writes frame 0 (when it starts afresh); stepFrame() runs one
+}  // namespace
+
+FrameSteps::FrameSteps(double frameDuration, int fixedSubsteps)
+    : remaining_(frameDuration),
+      fixed_(fixedSubsteps > 0 ? static_cast<float>(frameDuration / fixedSubsteps) : 0),
+      fixedSubsteps_(fixedSubsteps) {}
+
+float FrameSteps::next(double stable) {
+  float dt;
+  if (fixed_ > 0 && !shortened_ && stable >= fixed_) {
+    dt = fixed_;
+    remaining_ = steps_ + 1 == fixedSubsteps_ ? 0 : remaining_ - dt;
+  } else {
+    shortened_ = fixed_ > 0;
+    const double longest = fixed_ > 0 ? std::min<double>(stable, fixed_) : stable;
+    const double count = std::max(1.0, std::ceil(remaining_ / longest - 1e-9));
+    dt = static_cast<float>(remaining_ / count);
+    remaining_ = count == 1 ? 0 : remaining_ - dt;
+  }
+  ++steps_;
+  return dt;
+}
+
+std::string densityCapReport(const SimulationSummary& summary) {
+  return "stopped at its cap of " + std::to_string(summary.iterationCap) + " iterations in " +
+         std::to_string(summary.cappedSteps) + " of " + std::to_string(summary.steps) + " steps (frames " +
+         std::to_string(summary.firstCappedFrame) + "-" + std::to_string(summary.lastCappedFrame) + ")";
+}
+
+namespace {
+
+// The frame loop, for any solver, its steps as FrameSteps chooses them (a frame whose steps all meet the stable
+// step runs as before the need was checked). Each frame's record goes to every FrameOutput. The constructor sets the run up and writes frame 0 (when it starts afresh); stepFrame() runs one
 // frame and writes it.
 template <int Dim>
 class FrameLoop final : public SimulationRun {
@@ -235,23 +263,10 @@ class FrameLoop final : public SimulationRun {
     }
     int iterations = 0, divergenceIterations = 0, viscosityIterations = 0, steps = 0;
     float smallestStep = INFINITY;
-    double remaining = frameDuration_;
-    bool shortened = false;  // a step of this frame was shorter than the fixed substeps'
+    FrameSteps schedule(frameDuration_, solver.fixedSubsteps());
     constexpr int kMostSteps = 1000000;
-    while (remaining > 0) {
-      float dt;
-      const float fixed = solver.fixedSubsteps() > 0 ? static_cast<float>(frameDuration_ / solver.fixedSubsteps()) : 0;
-      const double stable = solver.stableTimeStep();
-      if (fixed > 0 && !shortened && stable >= fixed) {
-        dt = fixed;
-        remaining = steps + 1 == solver.fixedSubsteps() ? 0 : remaining - dt;
-      } else {
-        shortened = fixed > 0;
-        const double longest = fixed > 0 ? std::min<double>(stable, fixed) : stable;
-        const double count = std::max(1.0, std::ceil(remaining / longest - 1e-9));
-        dt = static_cast<float>(remaining / count);
-        remaining = count == 1 ? 0 : remaining - dt;
-      }
+    while (!schedule.done()) {
+      const float dt = schedule.next(solver.stableTimeStep());
       long badBody = -1;
       if (attractor_.active()) ledger.add(attractorWork(attractor_, solver, time, dt));
       if (!periodicGravity_.isZero()) ledger.add(periodicGravityWork(periodicGravity_, solver, dt));
@@ -329,10 +344,8 @@ class FrameLoop final : public SimulationRun {
         // Where the density solver stopped at its cap, more iterations are the remedy too.
         const char* key = fluidMethod(scene_.solver.method, scene_.source).iterationCapKey;
         if (summary_.cappedSteps == 0 || !key) throw;
-        throw RunError(std::string(stop.what()) + "; its density solver stopped at its cap of " +
-                       std::to_string(summary_.iterationCap) + " iterations in " +
-                       std::to_string(summary_.cappedSteps) + " of " + std::to_string(summary_.steps) +
-                       " steps, where a larger " + key + " lets it converge");
+        throw RunError(std::string(stop.what()) + "; its density solver " + densityCapReport(summary_) +
+                       ", where a larger " + key + " lets it converge");
       }
     record_.carriedState = solver.carriedState();
     for (const std::unique_ptr<FrameOutput>& output : outputs_) output->write(record_);

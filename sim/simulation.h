@@ -43,6 +43,25 @@ struct SimulationSummary {
   int iterationCap = 0, firstCappedFrame = 0, lastCappedFrame = 0;
 };
 
+// "stopped at its cap of N iterations in K of M steps (frames a-b)": the summary's capped steps, for a message.
+std::string densityCapReport(const SimulationSummary& summary);
+
+// The steps of one frame, the frame loop's rule: each the largest stable one (the solver's stableTimeStep, given
+// to next() before every step) shortened so that the steps left end exactly on the frame; with fixedSubsteps > 0,
+// that many equal steps while the stable step is no shorter, and stable ones for the rest of the frame once it is.
+class FrameSteps {
+ public:
+  FrameSteps(double frameDuration, int fixedSubsteps);
+  bool done() const { return remaining_ <= 0; }
+  float next(double stable);
+
+ private:
+  double remaining_;
+  float fixed_;
+  int fixedSubsteps_, steps_ = 0;
+  bool shortened_ = false;  // a step of this frame was shorter than the fixed substeps'
+};
+
 // Simulates the scene into dir: particles/frame_NNNNN.ply for frames 0..output.frames and stats.csv.
 // With resume, continues from the last complete frame in dir (frames are written whole or not at all), and
 // ends byte-identical to an uninterrupted run. Throws RunError naming frame, substep and particle if the

@@ -11,6 +11,7 @@
 
 #include "core/ply.h"
 #include "tests/apps/run_surge.h"
+#include "tests/sim/stats_columns.h"
 
 extern char** environ;
 
@@ -69,11 +70,8 @@ TEST(SimCommand, SaysWhereTheDensitySolverStoppedAtItsCap) {
                                    out.string());
     EXPECT_EQ(r.status, 0) << r.err;
     size_t steps = 0;
-    std::ifstream stats(out / "stats.csv");
-    std::string line;
-    std::getline(stats, line);
-    while (std::getline(stats, line))
-      if (line.rfind("0,", 0) != 0) steps += std::stoul(line.substr(line.find(',', line.find(',', line.find(',') + 1) + 1) + 1));
+    const std::vector<double> substeps = readStats(out).at("substeps");
+    for (size_t f = 1; f < substeps.size(); ++f) steps += size_t(substeps[f]);
     return std::make_pair(r.out, steps);
   };
   const auto [capped, steps] = run("--set solver.method=dfsph --set solver.max_iterations=3 "

@@ -57,21 +57,9 @@ double growthRate(const std::string& method, const std::vector<std::string>& set
   const double frameTime = 1.0 / scene.output.fps;
   for (int f = 1; f <= scene.output.frames; ++f) {
     solver->beginFrame(time);
-    double remaining = frameTime;
-    bool shortened = false;
-    for (int steps = 0; remaining > 0; ++steps) {  // as the frame loop steps (sim/simulation.cpp)
-      const int substeps = solver->fixedSubsteps();
-      const double fixed = substeps > 0 ? frameTime / substeps : 0, stable = solver->stableTimeStep();
-      float dt;
-      if (fixed > 0 && !shortened && stable >= fixed) {
-        dt = float(fixed);
-        remaining = steps + 1 == substeps ? 0 : remaining - dt;
-      } else {
-        shortened = fixed > 0;
-        const double count = std::max(1.0, std::ceil(remaining / (fixed > 0 ? std::min(stable, fixed) : stable) - 1e-9));
-        dt = float(remaining / count);
-        remaining = count == 1 ? 0 : remaining - dt;
-      }
+    FrameSteps schedule(frameTime, solver->fixedSubsteps());  // as the frame loop steps
+    while (!schedule.done()) {
+      const float dt = schedule.next(solver->stableTimeStep());
       const long bad = solver->step(dt, time);
       if (bad >= 0) {
         ADD_FAILURE() << method << " at t = " << time << ": particle " << bad << " at "
