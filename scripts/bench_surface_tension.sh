@@ -3,8 +3,8 @@
 # the same step (solver.time_step, the capillary limit), so that the time a step is compared step for step; and
 # the share of the step its pass takes (docs/performance.md).
 #
-#   scripts/bench_surface_tension.sh [SURGE_BINARY] [METHOD] [FRAMES]   (20 frames: PBF's drops gain energy by 0.7 s,
-#   docs/surface-tension.md)
+#   scripts/bench_surface_tension.sh [SURGE_BINARY] [METHOD] [FRAMES]   (default 20 frames: before session 58 PBF's
+#   drops gained energy by 0.7 s, docs/surface-tension.md)
 set -euo pipefail
 surge=${1:-build/apps/surge}
 method=${2:-dfsph}

@@ -91,6 +91,7 @@ class PbfSolver final : public ParticleSolver<Dim> {
   // kPeriodic: pairs take their nearest image (sim/periodic.h); without it the loops are what they were.
   template <bool kWarmStart, bool kPeriodic>
   void applyPositionCorrectionsOf();
+  void pullBySurfaceTension(float dt);
   void updateVelocities(float dt);
   // p*_i += delta_i, stopped at the colliders and the tank (the position corrections, the push).
   void moveBy(const std::vector<VecD>& delta);

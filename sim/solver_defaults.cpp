@@ -235,8 +235,8 @@ std::vector<std::string> solverNotes(const Scene& scene) {
                   "keeps its shape instead of rounding; solver.kernel_radius %g (3 spacings) lets it flow%s "
                   "(docs/surface-tension.md)",
                   scene.solver.kernel_radius / scene.particle_spacing, 3 * scene.particle_spacing,
-                  scene.solver.method == "pbf" ? ", with a viscosity (fluids[i].viscosity) in PBF, whose drops gain "
-                                                 "energy from the curvature force without one"
+                  scene.solver.method == "pbf" ? ", with a viscosity (fluids[i].viscosity) in PBF, whose water drop "
+                                                 "keeps a set of 4% without one"
                                                : "");
     notes.push_back(text);
   }

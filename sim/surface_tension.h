@@ -63,6 +63,7 @@ class SurfaceTension {
   // v_i += dt a_i, counting the work sum m a . (v + dt a / 2) dt; `massRatio`: each particle's mass over the
   // method's (empty: one fluid).
   void kick(std::vector<VecD>& v, float dt, const std::vector<float>& massRatio);
+  const std::vector<VecD>& accelerations() const { return accel_; }
   // a_i += the accelerations (WCSPH), and the work over a step dt at velocities v (addWork).
   void addTo(std::vector<VecD>& a) const;
   void addWork(const std::vector<VecD>& v, float dt, const std::vector<float>& massRatio);

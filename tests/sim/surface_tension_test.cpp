@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -144,34 +145,32 @@ std::vector<double> oscillationCrossings(FluidSolver<Dim>& solver, double a, dou
   return crossings;
 }
 
-// Rayleigh 1879: a drop's l = 2 oscillation has omega^2 = 8 sigma / (rho R^3) in 3D (6 in 2D). PBF, 3D, 20
-// particles across: a relaxed drop given 10% of the mode's flow first returns to its rest shape after half a
-// period, within the issue's 10% (measured 0.95 of Rayleigh's; docs/surface-tension.md has every method's).
-TEST(SurfaceTension, AThreeDimensionalDropOscillatesAtRayleighsFrequencyInPbf) {
+// Rayleigh 1879: a drop's l = 2 oscillation has omega^2 = 8 sigma / (rho R^3) in 3D (6 in 2D). 3D, 20 particles
+// across, 2.5 spacings of support (solver.kernel_radius 2.5 mm): a relaxed drop given 10% of the mode's flow
+// first comes back through its rest shape after half a period, and its next four half periods average one, each
+// within the issue's 10%. Measured: DFSPH 0.958 and 0.988, PBF 1.019 and 0.970. At the default support of 2
+// spacings the drop keeps a set: DFSPH's never crosses, PBF's crosses at 0.96 and 1.30 half periods and then no
+// more (the test fails); docs/surface-tension.md has every method's.
+void expectRayleighsFrequencyWithAWiderKernel(const std::string& method) {
   const double radius = 0.01, omega = std::sqrt(8 * kSigma / (kRho * std::pow(radius, 3)));
-  auto solver = makeFluidSolver<3>(dropScene(3, "pbf", radius));
-  relaxDrop<3>(*solver, radius, 0.2);
-  ASSERT_FALSE(::testing::Test::HasFatalFailure());
-  const std::vector<double> crossings = oscillationCrossings<3>(*solver, 0.1 * omega, 3 * M_PI / omega, 1);
-  ASSERT_EQ(crossings.size(), 1u) << "the drop did not come back through its rest shape";
-  EXPECT_NEAR(crossings[0] / (M_PI / omega), 1.0, 0.1);
-}
-
-// The same drop in DFSPH with 2.5 spacings of support (solver.kernel_radius 2.5 mm) in place of the default 2:
-// it first comes back through its rest shape at 0.958 of Rayleigh's half period, and its next four half periods
-// average 0.988 of it, both within the issue's 10%. With 2 spacings the drop keeps a set and never crosses (the
-// test fails); with 3, 0.987 and 0.911 (docs/surface-tension.md).
-TEST(SurfaceTension, AThreeDimensionalDropOscillatesAtRayleighsFrequencyInDfsphWithAWiderKernel) {
-  const double radius = 0.01, omega = std::sqrt(8 * kSigma / (kRho * std::pow(radius, 3)));
-  auto solver = makeFluidSolver<3>(dropScene(3, "dfsph", radius, {"solver.kernel_radius=0.0025"}));
+  auto solver = makeFluidSolver<3>(dropScene(3, method, radius, {"solver.kernel_radius=0.0025"}));
   relaxDrop<3>(*solver, radius, 0.2);
   ASSERT_FALSE(::testing::Test::HasFatalFailure());
   const double half = M_PI / omega;
   const std::vector<double> crossings = oscillationCrossings<3>(*solver, 0.1 * omega, 5 * half, 5);
-  for (double t : crossings) std::printf("back through its rest shape at %.4f half periods\n", t / half);
+  for (double t : crossings)
+    std::printf("%s: back through its rest shape at %.4f half periods\n", method.c_str(), t / half);
   ASSERT_EQ(crossings.size(), 5u) << "the drop did not oscillate";
   EXPECT_NEAR(crossings[0] / half, 1.0, 0.1);
   EXPECT_NEAR((crossings[4] - crossings[0]) / 4 / half, 1.0, 0.1);
+}
+
+TEST(SurfaceTension, AThreeDimensionalDropOscillatesAtRayleighsFrequencyInPbfWithAWiderKernel) {
+  expectRayleighsFrequencyWithAWiderKernel("pbf");
+}
+
+TEST(SurfaceTension, AThreeDimensionalDropOscillatesAtRayleighsFrequencyInDfsphWithAWiderKernel) {
+  expectRayleighsFrequencyWithAWiderKernel("dfsph");
 }
 
 // Laplace: a drop at rest holds a pressure (d - 1) sigma / R above the air's. The solver's own pressure holds the
@@ -291,21 +290,30 @@ TEST(SurfaceTension, AJitteredBoxDropRoundsToWithinTwoPercentInDfsph3D) {
   expectRoundWithinTwoPercent(scene, "jittered_box_drop", {30, 45});
 }
 
-// The same box in PBF 3D meets it as a viscous drop: with nu = 2e-4 m^2/s (fluids[0].viscosity, 200 times water's)
-// and from the lattice, read at 1, 1.5 and 2 s. Measured 0.79%, 1.03% and 0.78% (1.5e-4: 1.0 to 1.6%). With water's
-// viscosity PBF rounds it to 1% by 0.33 s, then the curvature term's work (not a potential's gradient) makes it
-// gain energy, and the energy check stops the run in frame 23 (docs/surface-tension.md).
-TEST(SurfaceTension, AViscousBoxDropRoundsToWithinTwoPercentInPbf3D) {
-  Scene scene = boxDropScene("pbf", {"fluids[0].viscosity=2e-4"});
+// The same box in PBF 3D at its defaults, water: under 2% at 1, 1.5 and 2 s (measured 1.08%, 0.71%, 0.87%), and
+// at no frame more kinetic energy than the surface energy rounding can release, sigma (A_box - A_sphere) = 24.3
+// uJ (measured at most 8.5 uJ). PBF takes the model's forces at its predicted positions, before the constraints
+// (PbfSolver::pullBySurfaceTension); taken at the projected ones, as an external force, the cohesion fed the drop
+// energy and the energy check stopped the run in frame 23 (the test fails).
+TEST(SurfaceTension, ABoxDropRoundsToWithinTwoPercentInPbf3DAtItsDefaults) {
+  Scene scene = boxDropScene("pbf");
   scene.output.frames = 60;
-  expectRoundWithinTwoPercent(scene, "viscous_box_drop_pbf", {30, 45, 60});
+  expectRoundWithinTwoPercent(scene, "box_drop_pbf", {30, 45, 60});
+  const double volume = 24e-3 * 12e-3 * 12e-3, boxArea = 2 * (2 * 24e-3 * 12e-3 + 12e-3 * 12e-3);
+  const double sphereArea = std::pow(M_PI, 1.0 / 3) * std::pow(6 * volume, 2.0 / 3);
+  const auto kinetic = readStats(fs::path(::testing::TempDir()) / "box_drop_pbf").at("kinetic_energy");
+  ASSERT_EQ(kinetic.size(), 61u);
+  const double most = *std::max_element(kinetic.begin(), kinetic.end());
+  std::printf("most kinetic energy %.3g J against %.3g J released\n", most, kSigma * (boxArea - sphereArea));
+  EXPECT_LE(most, kSigma * (boxArea - sphereArea));
 }
 
 // In 2D the issue's 2% holds with a kernel of 3 spacings' support (solver.kernel_radius 3 mm) in every method,
-// for a viscous drop (nu = 2e-4 m^2/s, as PBF's 3D box above): the 30 x 15 rectangle (R = 12 mm as a circle) at 1,
-// 1.5 and 2 s. Measured DFSPH 0.9%, 0.8%, 0.5%; WCSPH 1.3%, 0.9%, 0.6%; PBF 1.3%, 1.6%, 1.5%. At the default
+// for a viscous drop (nu = 2e-4 m^2/s): the 30 x 15 rectangle (R = 12 mm as a circle) at 1,
+// 1.5 and 2 s. Measured DFSPH 0.9%, 0.8%, 0.5%; WCSPH 1.3%, 0.9%, 0.6%; PBF 0.9%, 0.6%, 0.7%. At the default
 // support of 2 spacings the square lattice re-packs into a hexagonal crystal that holds the rectangle's shape
-// (DFSPH 0.56 viscous, 0.60 as water; WCSPH 0.53, PBF 0.12) and the test fails (docs/surface-tension.md, "A wider kernel").
+// (DFSPH 0.56 viscous, 0.60 as water; WCSPH 0.53, PBF 0.27) and the test fails (docs/surface-tension.md, "A wider
+// kernel").
 TEST(SurfaceTension, AViscousRectangleRoundsToWithinTwoPercentIn2DWithAWiderKernel) {
   for (const std::string method : {"dfsph", "wcsph", "pbf"}) {
     Scene scene = dropScene(2, method, 0.012, {"solver.kernel_radius=0.003", "fluids[0].viscosity=2e-4"});
@@ -317,34 +325,35 @@ TEST(SurfaceTension, AViscousRectangleRoundsToWithinTwoPercentIn2DWithAWiderKern
 }
 
 // Surface tension keeps a run's bytes the same at any thread count, and a resumed run ends where an uninterrupted
-// one does (2D and 3D).
+// one does (every method, 2D and 3D).
 TEST(SurfaceTension, SameBytesAtAnyThreadCountAndAfterAResume) {
-  for (int dim : {2, 3}) {
-    SCOPED_TRACE(std::to_string(dim) + "D");
-    Scene scene = dropScene(dim, "dfsph", 0.004);
-    for (int k = 0; k < dim; ++k) {
-      scene.fluids[0].box.min[k] = -0.004;
-      scene.fluids[0].box.max[k] = k == 0 ? 0.006 : 0.004;
+  for (const std::string method : {"dfsph", "pbf", "wcsph"})
+    for (int dim : {2, 3}) {
+      SCOPED_TRACE(method + " " + std::to_string(dim) + "D");
+      Scene scene = dropScene(dim, method, 0.004);
+      for (int k = 0; k < dim; ++k) {
+        scene.fluids[0].box.min[k] = -0.004;
+        scene.fluids[0].box.max[k] = k == 0 ? 0.006 : 0.004;
+      }
+      scene.output.frames = 6;
+      auto run = [&](const std::string& name, int threads, int frames, bool resume) {
+        Scene s = scene;
+        s.output.frames = frames;
+        const fs::path dir = runScene(s, name, threads, resume);
+        return frames == 6 ? readTextFile(framePath(dir, "particles", 6, "ply")) : std::string();
+      };
+      const std::string two = run("st_two", 2, 6, false);
+      EXPECT_EQ(run("st_one", 1, 6, false), two);
+      run("st_resumed", 2, 3, false);
+      EXPECT_EQ(run("st_resumed", 1, 6, true), two);
     }
-    scene.output.frames = 6;
-    auto run = [&](const std::string& name, int threads, int frames, bool resume) {
-      Scene s = scene;
-      s.output.frames = frames;
-      const fs::path dir = runScene(s, name, threads, resume);
-      return frames == 6 ? readTextFile(framePath(dir, "particles", 6, "ply")) : std::string();
-    };
-    const std::string two = run("st_two", 2, 6, false);
-    EXPECT_EQ(run("st_one", 1, 6, false), two);
-    run("st_resumed", 2, 3, false);
-    EXPECT_EQ(run("st_resumed", 1, 6, true), two);
-  }
 }
 
 // Several fluids: each pulls together with its own sigma and sees the other as air, so their interface holds
 // sigma_1 + sigma_2 (sim/surface_tension.h). A 2:1 rectangle of oil (rho 900, sigma 0.03, 30 x 15 particles)
 // inside water (sigma 0.0728) in zero gravity starts at anisotropy 0.60 and rounds in every method. Measured at
-// 1 s: DFSPH 0.47, PBF 0.08, WCSPH 0.53; DFSPH and WCSPH stop short of round as one fluid's 2D rectangle does
-// (0.62 and 0.57, the lattice's set, docs/surface-tension.md), so the bound is only that the interface pulls:
+// 1 s: DFSPH 0.47, PBF 0.28, WCSPH 0.53; each stops short of round as one fluid's 2D rectangle does (DFSPH
+// 0.62, WCSPH 0.57: the lattice's set, docs/surface-tension.md), so the bound is only that the interface pulls:
 // under 0.56, two thirds of WCSPH's fall. Without the sigmas the rectangle keeps 0.601 to 1e-3. In DFSPH the run
 // is the same bytes at 1 and 2 threads and after a resume.
 Scene oilInWater(const std::string& method, bool tension) {
@@ -439,7 +448,7 @@ TEST(SurfaceTension, SurgeSimSaysA2DDropAtTheDefaultSupportKeepsItsShape) {
   EXPECT_EQ(crystalNotes(2, {"solver.kernel_radius=0.003"}), 0);
   EXPECT_EQ(crystalNotes(3, {}), 0);
   EXPECT_EQ(crystalNotes(2, {"fluids[0].surface_tension=0"}), 0);
-  // PBF's 2D water drop at 3 spacings gains energy and flies apart (docs/surface-tension.md): the note says so.
+  // PBF's 2D water drop at 3 spacings keeps a set of 4% (docs/surface-tension.md): the note asks for a viscosity.
   const std::vector<std::string> pbf = solverNotes(dropScene(2, "pbf", 0.005));
   ASSERT_EQ(pbf.size(), 1u);
   EXPECT_NE(pbf[0].find("viscosity"), std::string::npos) << pbf[0];
