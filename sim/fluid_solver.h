@@ -140,6 +140,9 @@ struct FluidMethod {
   // The key that caps its density iterations where it iterates to solver.max_density_error (FluidSolver::
   // densityIterationCap), for surge sim's report and the energy stop's remedy; null for none.
   const char* iterationCapKey = nullptr;
+  // Where the adhesion's calibration misses Young's angle in this method: the test's drop on a plate at adhesion
+  // 0.25, 0.5, 0.75 in degrees, for surge sim's note (docs/surface-tension.md, "By method"); null where it holds.
+  const char* adhesionAngles = nullptr;
 };
 
 // FluidMethod::make2 and make3 for a solver class template.

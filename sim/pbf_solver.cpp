@@ -414,6 +414,8 @@ void PbfSolver<Dim>::pullBySurfaceTension(float dt) {
   const PhaseTimer timer(times_.forces);
   const auto& a = this->tension_.accelerations();
   const float dt2 = dt * dt;
+  // Stopped as predictPositions stops x*, not as moveBy: found_ (the colliders at x*) may still be last step's,
+  // which the first lambda pass finds again.
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const VecD before = p_[i];

@@ -226,14 +226,15 @@ std::vector<std::string> solverNotes(const Scene& scene) {
                     " spacings it may not give Young's angle: measured, 2.5 wets more (104 and 69 degrees at 0.25 and "
                     "0.5, a film at 0.75) and 3 less (118, 101, 84) (docs/surface-tension.md)");
   }
-  // The adhesion's calibration meets Young's angle in DFSPH; PBF and WCSPH answer it with a smaller slope
-  // (docs/surface-tension.md, "By method").
-  if (sceneHasAdhesion(scene) && sceneSurfaceTension(scene) > 0 && scene.solver.method != "dfsph") {
-    const bool pbf = scene.solver.method == "pbf";
+  // The adhesion's calibration meets Young's angle in DFSPH; where a method's does not, its registration gives
+  // the angles it reads (FluidMethod::adhesionAngles).
+  if (sceneHasAdhesion(scene) && sceneSurfaceTension(scene) > 0 && method.adhesionAngles) {
+    std::string name = method.name;
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::toupper(c)); });
     notes.push_back("adhesion is calibrated in DFSPH (a drop on a plate at 117, 86, 63 degrees for adhesion 0.25, 0.5, "
-                    "0.75; Young's 120, 90, 60); in " + std::string(pbf ? "PBF" : "WCSPH") + " the same drop reads " +
-                    (pbf ? "112, 91, 82" : "127, 113, 100") + " degrees: its angle answers the adhesion about half as "
-                    "much as Young's does (docs/surface-tension.md)");
+                    "0.75; Young's 120, 90, 60); in " + name + " the same drop reads " + method.adhesionAngles +
+                    " degrees: its angle answers the adhesion about half as much as Young's does "
+                    "(docs/surface-tension.md)");
   }
   // In 2D, cohesion over 2 spacings of support holds the lattice as a crystal (docs/surface-tension.md).
   if (scene.dimensions == 2 && sceneSurfaceTension(scene) > 0 &&

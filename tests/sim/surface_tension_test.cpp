@@ -222,8 +222,9 @@ Scene boxDropScene(const std::string& method, const std::vector<std::string>& ex
   return scene;
 }
 
-// Runs `scene` to its last frame and expects the anisotropy under the 2% at each of `frames`.
-void expectRoundWithinTwoPercent(const Scene& scene, const std::string& name, const std::vector<int>& frames) {
+// Runs `scene` to its last frame and expects the anisotropy under the 2% at each of `frames`; returns the
+// run's folder.
+fs::path expectRoundWithinTwoPercent(const Scene& scene, const std::string& name, const std::vector<int>& frames) {
   const fs::path dir = runScene(scene, name);
   for (const int frame : frames) {
     const std::vector<Eigen::Vector3f> positions = readParticlePly(framePath(dir, "particles", frame, "ply")).position;
@@ -239,6 +240,7 @@ void expectRoundWithinTwoPercent(const Scene& scene, const std::string& name, co
     std::printf("%s, frame %d: anisotropy %.4f\n", name.c_str(), frame, value);
     EXPECT_LT(value, 0.02) << "frame " << frame;
   }
+  return dir;
 }
 
 // The most surface energy the energy account credits is sigma times the lattice's own faces, wherever the block
@@ -298,10 +300,10 @@ TEST(SurfaceTension, AJitteredBoxDropRoundsToWithinTwoPercentInDfsph3D) {
 TEST(SurfaceTension, ABoxDropRoundsToWithinTwoPercentInPbf3DAtItsDefaults) {
   Scene scene = boxDropScene("pbf");
   scene.output.frames = 60;
-  expectRoundWithinTwoPercent(scene, "box_drop_pbf", {30, 45, 60});
+  const fs::path dir = expectRoundWithinTwoPercent(scene, "box_drop_pbf", {30, 45, 60});
   const double volume = 24e-3 * 12e-3 * 12e-3, boxArea = 2 * (2 * 24e-3 * 12e-3 + 12e-3 * 12e-3);
   const double sphereArea = std::pow(M_PI, 1.0 / 3) * std::pow(6 * volume, 2.0 / 3);
-  const auto kinetic = readStats(fs::path(::testing::TempDir()) / "box_drop_pbf").at("kinetic_energy");
+  const auto kinetic = readStats(dir).at("kinetic_energy");
   ASSERT_EQ(kinetic.size(), 61u);
   const double most = *std::max_element(kinetic.begin(), kinetic.end());
   std::printf("most kinetic energy %.3g J against %.3g J released\n", most, kSigma * (boxArea - sphereArea));
