@@ -30,7 +30,7 @@ struct SolverSettings {
   std::string method = "pbf";
   int substeps = 0;  // 0 in the file: max(4, stableSubsteps) (resolved)
   int iterations = 4;
-  double kernel_radius = 0;  // 0 in the file: 2 x particle_spacing (resolved on load)
+  double kernel_radius = 0;  // 0 in the file: 2 x particle_spacing, wider in 2D with surface tension (resolved on load)
   double rest_density = 1000;
   double relaxation_epsilon = 0.01;
   double warm_start = 0;  // PBF: share of last step's lambda sums applied before the iterations (experimental)
@@ -335,6 +335,7 @@ SolverDefaults& solverDefaults();
 struct SolverMethodEntry {
   std::string name, description;
   void (*declareKeys)(SceneVisitor&, SolverSettings&) = nullptr;  // its own keys under `solver`
+  double surfaceTensionSupport2d = 2;  // solver.kernel_radius 0's spacings in 2D with surface tension
 };
 std::vector<SolverMethodEntry>& solverMethodCatalog();
 

@@ -239,6 +239,17 @@ void validateWhitewater(Scene& s, const std::string& where) {
     throw InputError(where, "whitewater.bubble_neighbors", "must not be below spray_neighbors");
 }
 
+// solver.kernel_radius 0's support in spacings: 2, or in 2D with surface tension the method's own (where its
+// cohesion lets a drop flow rather than hold as a crystal: SolverMethodEntry::surfaceTensionSupport2d).
+double defaultSupport(const Scene& s) {
+  const bool tension =
+      std::any_of(s.fluids.begin(), s.fluids.end(), [](const FluidBlock& f) { return f.surface_tension > 0; });
+  if (s.dimensions != 2 || !tension) return 2;
+  for (const SolverMethodEntry& method : solverMethodCatalog())
+    if (method.name == s.solver.method) return method.surfaceTensionSupport2d;
+  return 2;
+}
+
 }  // namespace
 
 std::vector<double> restNeighborDistances(const Scene& s) {
@@ -302,7 +313,7 @@ void validateScene(Scene& s, const std::string& where) {
   validateSources(s, where);
 
   SolverSettings& solver = s.solver;
-  if (solver.kernel_radius == 0) solver.kernel_radius = 2 * spacing;
+  if (solver.kernel_radius == 0) solver.kernel_radius = defaultSupport(s) * spacing;
   if (solver.kernel_radius <= spacing)
     throw InputError(where, "solver.kernel_radius", "must exceed particle_spacing, or particles have no neighbours");
   // The neighbour grid covers the particles' box only (sparsely if need be); cell coordinates must fit.

@@ -23,7 +23,9 @@ std::vector<FluidMethod>& registry() {
 // (core/scene.h).
 bool installInSceneReader() {
   solverDefaults() = &resolveSolverDefaults;
-  for (const FluidMethod& method : registry()) solverMethodCatalog().push_back({method.name, method.description, method.declareKeys});
+  for (const FluidMethod& method : registry())
+    solverMethodCatalog().push_back(
+        {method.name, method.description, method.declareKeys, method.surfaceTensionSupport2d});
   return true;
 }
 [[maybe_unused]] const bool kInstalled = installInSceneReader();
@@ -41,7 +43,8 @@ void registerFluidMethod(const FluidMethod& method) {
     if (std::string(known.name) == method.name)
       throw std::logic_error(std::string("registerFluidMethod: \"") + method.name + "\" is registered already");
   registry().push_back(method);
-  solverMethodCatalog().push_back({method.name, method.description, method.declareKeys});
+  solverMethodCatalog().push_back(
+      {method.name, method.description, method.declareKeys, method.surfaceTensionSupport2d});
 }
 
 template <int Dim>

@@ -143,6 +143,10 @@ struct FluidMethod {
   // Where the adhesion's calibration misses Young's angle in this method: the test's drop on a plate at adhesion
   // 0.25, 0.5, 0.75 in degrees, for surge sim's note (docs/surface-tension.md, "By method"); null where it holds.
   const char* adhesionAngles = nullptr;
+  // The kernel's support, in spacings, that solver.kernel_radius 0 gives a 2D scene with surface tension: at 2
+  // spacings its cohesion holds a 2D drop as a crystal; the method's own width lets it round and ring at
+  // Rayleigh's frequency (docs/surface-tension.md, "The 2D support").
+  double surfaceTensionSupport2d = 2;
 };
 
 // FluidMethod::make2 and make3 for a solver class template.

@@ -236,18 +236,16 @@ std::vector<std::string> solverNotes(const Scene& scene) {
                     " degrees: its angle answers the adhesion about half as much as Young's does "
                     "(docs/surface-tension.md)");
   }
-  // In 2D, cohesion over 2 spacings of support holds the lattice as a crystal (docs/surface-tension.md).
-  if (scene.dimensions == 2 && sceneSurfaceTension(scene) > 0 &&
-      scene.solver.kernel_radius < 2.75 * scene.particle_spacing) {
+  // In 2D, cohesion over 2 spacings of support holds the lattice as a crystal; the method's own width, which
+  // solver.kernel_radius 0 gives, lets a drop round (docs/surface-tension.md, "The 2D support").
+  const double own = method.surfaceTensionSupport2d;
+  if (scene.dimensions == 2 && sceneSurfaceTension(scene) > 0 && support < 2.75 && support < own - 1e-9) {
     char text[400];
     std::snprintf(text, sizeof text,
                   "surface tension in 2D with %.3g spacings of kernel support holds the particles as a crystal: a drop "
-                  "keeps its shape instead of rounding; solver.kernel_radius %g (3 spacings) lets it flow%s "
-                  "(docs/surface-tension.md)",
-                  scene.solver.kernel_radius / scene.particle_spacing, 3 * scene.particle_spacing,
-                  scene.solver.method == "pbf" ? ", with a viscosity (fluids[i].viscosity) in PBF, whose water drop "
-                                                 "keeps a set of 4% without one"
-                                               : "");
+                  "keeps its shape instead of rounding; solver.kernel_radius 0 gives %s %.3g spacings (%g here), "
+                  "with which it rounds (docs/surface-tension.md)",
+                  support, method.name, own, own * scene.particle_spacing);
     notes.push_back(text);
   }
   // The transport velocity pushes particles out of a free surface.
