@@ -140,13 +140,17 @@ struct FluidMethod {
   // The key that caps its density iterations where it iterates to solver.max_density_error (FluidSolver::
   // densityIterationCap), for surge sim's report and the energy stop's remedy; null for none.
   const char* iterationCapKey = nullptr;
-  // Where the adhesion's calibration misses Young's angle in this method: the test's drop on a plate at adhesion
-  // 0.25, 0.5, 0.75 in degrees, for surge sim's note (docs/surface-tension.md, "By method"); null where it holds.
+  // Where the adhesion's calibration misses Young's angle in this method in 3D: the test's drop on a plate at
+  // adhesion 0.25, 0.5, 0.75 in degrees, for surge sim's note (docs/surface-tension.md, "By method"); null where it
+  // holds.
   const char* adhesionAngles = nullptr;
   // The kernel's support, in spacings, that solver.kernel_radius 0 gives a 2D scene with surface tension: at 2
   // spacings its cohesion holds a 2D drop as a crystal; the method's own width lets it round and ring at
   // Rayleigh's frequency (docs/surface-tension.md, "The 2D support").
   double surfaceTensionSupport2d = 2;
+  // The same drop in 2D at that support, in degrees, for surge sim's note (docs/surface-tension.md, "Adhesion in
+  // 2D"); null for none measured.
+  const char* adhesionAngles2d = nullptr;
 };
 
 // FluidMethod::make2 and make3 for a solver class template.

@@ -218,23 +218,34 @@ std::vector<std::string> solverNotes(const Scene& scene) {
   if (sceneHasAdhesion(scene) && sceneSurfaceTension(scene) == 0)
     notes.push_back("adhesion is set on a collider or body, but the fluid has no surface_tension: adhesion is a "
                     "share of the fluid's cohesion and does nothing without it");
-  // The adhesion's calibration holds at 2 spacings of support, not at 2.5 or 3 (docs/surface-tension.md).
   const double support = scene.solver.kernel_radius / scene.particle_spacing;
-  if (sceneHasAdhesion(scene) && sceneSurfaceTension(scene) > 0 && std::abs(support - 2) > 0.05) {
+  const bool adhesion = sceneHasAdhesion(scene) && sceneSurfaceTension(scene) > 0;
+  std::string name = method.name;
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::toupper(c)); });
+  // In 3D the adhesion's calibration holds at 2 spacings of support, not at 2.5 or 3 (docs/surface-tension.md).
+  if (adhesion && scene.dimensions == 3 && std::abs(support - 2) > 0.05) {
     notes.push_back("adhesion is calibrated at 2 spacings of kernel support (contact angles 122, 91, 70 degrees at "
                     "adhesion 0.25, 0.5, 0.75, Young's 120, 90, 60); with " + threeFigures(support) +
                     " spacings it may not give Young's angle: measured, 2.5 wets more (104 and 69 degrees at 0.25 and "
                     "0.5, a film at 0.75) and 3 less (118, 101, 84) (docs/surface-tension.md)");
   }
-  // The adhesion's calibration meets Young's angle in DFSPH; where a method's does not, its registration gives
-  // the angles it reads (FluidMethod::adhesionAngles).
-  if (sceneHasAdhesion(scene) && sceneSurfaceTension(scene) > 0 && method.adhesionAngles) {
-    std::string name = method.name;
-    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::toupper(c)); });
+  // It meets Young's angle in DFSPH; where a method's does not, its registration gives the angles it reads
+  // (FluidMethod::adhesionAngles).
+  if (adhesion && scene.dimensions == 3 && method.adhesionAngles) {
     notes.push_back("adhesion is calibrated in DFSPH (a drop on a plate at 117, 86, 63 degrees for adhesion 0.25, 0.5, "
                     "0.75; Young's 120, 90, 60); in " + name + " the same drop reads " + method.adhesionAngles +
                     " degrees: its angle answers the adhesion about half as much as Young's does "
                     "(docs/surface-tension.md)");
+  }
+  // In 2D each method's angles are measured at its own 2D support (FluidMethod::adhesionAngles2d).
+  if (adhesion && scene.dimensions == 2 && method.adhesionAngles2d) {
+    const double own = method.surfaceTensionSupport2d;
+    notes.push_back("adhesion in 2D: a drop on a plate in " + name + " at its own " + threeFigures(own) +
+                    " spacings of kernel support reads " + method.adhesionAngles2d +
+                    " degrees at adhesion 0.25, 0.5, 0.75, where Young's angle is 120, 90, 60" +
+                    (std::abs(support - own) > 0.05 ? "; at this scene's " + threeFigures(support) + " it is not measured"
+                                                    : std::string()) +
+                    " (docs/surface-tension.md)");
   }
   // In 2D, cohesion over 2 spacings of support holds the lattice as a crystal; the method's own width, which
   // solver.kernel_radius 0 gives, lets a drop round (docs/surface-tension.md, "The 2D support").
@@ -245,7 +256,7 @@ std::vector<std::string> solverNotes(const Scene& scene) {
                   "surface tension in 2D with %.3g spacings of kernel support holds the particles as a crystal: a drop "
                   "keeps its shape instead of rounding; solver.kernel_radius 0 gives %s %.3g spacings (%g here), "
                   "with which it rounds (docs/surface-tension.md)",
-                  support, method.name, own, own * scene.particle_spacing);
+                  support, name.c_str(), own, own * scene.particle_spacing);
     notes.push_back(text);
   }
   // The transport velocity pushes particles out of a free surface.

@@ -549,6 +549,36 @@ TEST(SurfaceTension, SurgeSimSaysTheAdhesionIsCalibratedInDfsph) {
   EXPECT_TRUE(methodNotes("pbf", {"colliders[0].adhesion=0.5", "fluids[0].surface_tension=0"}).empty());
 }
 
+// In 2D surge sim gives each method's own angles (FluidMethod::adhesionAngles2d, the 3D test's drop in 2D at the
+// method's 2D support: DFSPH 124, 92, 19; PBF 121, 90, 73; WCSPH 131, 114, 98 degrees) in place of the 3D notes,
+// and says where the scene's support is not the one they were measured at.
+TEST(SurfaceTension, SurgeSimGivesEachMethodsAdhesionAnglesIn2D) {
+  auto adhesionNotes = [](const std::string& method, const std::vector<std::string>& extra) {
+    std::string json = R"({"name": "plate", "dimensions": 2, "domain": {"min": [-0.03, -0.006], "max": [0.03, 0.03]},
+        "particle_spacing": 0.001, "gravity": [0, 0], "solver": {"method": ")" + method + R"("},
+        "fluids": [{"box": {"min": [-0.006, 0], "max": [0.006, 0.012]}, "surface_tension": 0.0728}],
+        "colliders": [{"shape": "box", "position": [0, -0.003], "size": [0.06, 0.006]}]})";
+    std::vector<std::string> found;
+    for (const std::string& note : solverNotes(parseScene(json, "plate.json", extra)))
+      if (note.find("adhesion") != std::string::npos) found.push_back(note);
+    return found;
+  };
+  const std::vector<std::pair<std::string, std::string>> angles = {
+      {"dfsph", "DFSPH at its own 4 spacings of kernel support reads 124, 92, 19 degrees"},
+      {"pbf", "PBF at its own 2.5 spacings of kernel support reads 121, 90, 73 degrees"},
+      {"wcsph", "WCSPH at its own 4 spacings of kernel support reads 131, 114, 98 degrees"}};
+  for (const auto& [method, text] : angles) {
+    const auto own = adhesionNotes(method, {"colliders[0].adhesion=0.5"});
+    ASSERT_EQ(own.size(), 1u) << method;
+    EXPECT_NE(own[0].find(text), std::string::npos) << own[0];
+    EXPECT_EQ(own[0].find("not measured"), std::string::npos) << own[0];
+    const auto narrow = adhesionNotes(method, {"colliders[0].adhesion=0.5", "solver.kernel_radius=0.002"});
+    ASSERT_EQ(narrow.size(), 1u) << method;
+    EXPECT_NE(narrow[0].find("at this scene's 2 it is not measured"), std::string::npos) << narrow[0];
+    EXPECT_TRUE(adhesionNotes(method, {}).empty()) << method;
+  }
+}
+
 // Bad input: one line naming the key.
 TEST(SurfaceTension, BadInputIsRefusedNamingTheKey) {
   auto message = [](const std::vector<std::string>& overrides) {
