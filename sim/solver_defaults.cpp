@@ -218,7 +218,7 @@ std::vector<std::string> solverNotes(const Scene& scene) {
   if (sceneHasAdhesion(scene) && sceneSurfaceTension(scene) == 0)
     notes.push_back("adhesion is set on a collider or body, but the fluid has no surface_tension: adhesion is a "
                     "share of the fluid's cohesion and does nothing without it");
-  const double support = scene.solver.kernel_radius / scene.particle_spacing;
+  const double support = scene.solver.kernel_radius / scene.particle_spacing, own = method.surfaceTensionSupport2d;
   const bool adhesion = sceneHasAdhesion(scene) && sceneSurfaceTension(scene) > 0;
   std::string name = method.name;
   std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::toupper(c)); });
@@ -239,17 +239,15 @@ std::vector<std::string> solverNotes(const Scene& scene) {
   }
   // In 2D each method's angles are measured at its own 2D support (FluidMethod::adhesionAngles2d).
   if (adhesion && scene.dimensions == 2 && method.adhesionAngles2d) {
-    const double own = method.surfaceTensionSupport2d;
+    const std::string elsewhere =
+        std::abs(support - own) > 0.05 ? "; at this scene's " + threeFigures(support) + " it is not measured" : "";
     notes.push_back("adhesion in 2D: a drop on a plate in " + name + " at its own " + threeFigures(own) +
                     " spacings of kernel support reads " + method.adhesionAngles2d +
-                    " degrees at adhesion 0.25, 0.5, 0.75, where Young's angle is 120, 90, 60" +
-                    (std::abs(support - own) > 0.05 ? "; at this scene's " + threeFigures(support) + " it is not measured"
-                                                    : std::string()) +
+                    " degrees at adhesion 0.25, 0.5, 0.75, where Young's angle is 120, 90, 60" + elsewhere +
                     " (docs/surface-tension.md)");
   }
   // In 2D, cohesion over 2 spacings of support holds the lattice as a crystal; the method's own width, which
   // solver.kernel_radius 0 gives, lets a drop round (docs/surface-tension.md, "The 2D support").
-  const double own = method.surfaceTensionSupport2d;
   if (scene.dimensions == 2 && sceneSurfaceTension(scene) > 0 && support < 2.75 && support < own - 1e-9) {
     char text[400];
     std::snprintf(text, sizeof text,
