@@ -4,9 +4,9 @@
 # the share of the step its pass takes (docs/performance.md).
 #
 #   scripts/bench_surface_tension.sh [SURGE_BINARY] [METHOD] [FRAMES] [DIMENSIONS]   (default 20 frames: before
-#   session 58 PBF's drops gained energy by 0.7 s, docs/surface-tension.md; DIMENSIONS 2 runs three 2D drops of
-#   water, whose default support is the method's own with surface tension and 2 spacings without, and also times
-#   them with surface tension at 2 spacings)
+#   session 58 PBF's drops gained energy by 0.7 s, docs/surface-tension.md; DIMENSIONS 2 runs droplets_2d, whose
+#   default support is the method's own with surface tension and 2 spacings without, and also times it with
+#   surface tension at 2 spacings)
 set -euo pipefail
 surge=${1:-build/apps/surge}
 method=${2:-dfsph}
@@ -15,16 +15,7 @@ dimensions=${4:-3}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 scene=scenes/droplets_zero_g.json
-if [ "$dimensions" = 2 ]; then
-  scene=$work/droplets_2d.json
-  cat > "$scene" <<'JSON'
-{"name": "droplets_2d", "dimensions": 2, "domain": {"min": [-0.06, -0.03], "max": [0.06, 0.03]},
- "particle_spacing": 0.001, "gravity": [0, 0], "output": {"fps": 30, "frames": 20},
- "fluids": [{"box": {"min": [-0.055, -0.0075], "max": [-0.025, 0.0075]}, "surface_tension": 0.0728},
-            {"box": {"min": [-0.015, -0.01], "max": [0.005, 0.01]}, "surface_tension": 0.0728},
-            {"box": {"min": [0.02, -0.006], "max": [0.05, 0.006]}, "surface_tension": 0.0728}]}
-JSON
-fi
+[ "$dimensions" = 2 ] && scene=scenes/droplets_2d.json
 common=(--set output.frames="$frames" --set solver.method="$method" --set solver.time_step=0.0014 --set solver.substeps=24 --quiet)
 "$surge" sim "$scene" --out "$work/with" "${common[@]}"
 "$surge" sim "$scene" --out "$work/without" "${common[@]}" --set fluids[0].surface_tension=0 \
