@@ -19,13 +19,16 @@ std::vector<FluidMethod>& registry() {
   return methods;
 }
 
+// What core's scene reader knows of a method (core/scene.h, SolverMethodEntry).
+SolverMethodEntry catalogEntry(const FluidMethod& method) {
+  return {method.name, method.description, method.declareKeys, method.surfaceTensionSupport2d};
+}
+
 // The scene reader learns the methods' names and resolves their defaults wherever the simulator is linked
 // (core/scene.h).
 bool installInSceneReader() {
   solverDefaults() = &resolveSolverDefaults;
-  for (const FluidMethod& method : registry())
-    solverMethodCatalog().push_back(
-        {method.name, method.description, method.declareKeys, method.surfaceTensionSupport2d});
+  for (const FluidMethod& method : registry()) solverMethodCatalog().push_back(catalogEntry(method));
   return true;
 }
 [[maybe_unused]] const bool kInstalled = installInSceneReader();
@@ -43,8 +46,7 @@ void registerFluidMethod(const FluidMethod& method) {
     if (std::string(known.name) == method.name)
       throw std::logic_error(std::string("registerFluidMethod: \"") + method.name + "\" is registered already");
   registry().push_back(method);
-  solverMethodCatalog().push_back(
-      {method.name, method.description, method.declareKeys, method.surfaceTensionSupport2d});
+  solverMethodCatalog().push_back(catalogEntry(method));
 }
 
 template <int Dim>
