@@ -278,8 +278,10 @@ void visitScene(Scene& s, SceneVisitor& v) {
                          "deep enough to need them (dt <= 0.9 particle_spacing / sqrt(g depth)) or an emitter fast "
                          "enough to (its jet moves at most half a spacing a step)", "", 100000));
     v.real("kernel_radius", s.solver.kernel_radius,
-           atLeast(0, "SPH kernel radius h; 0 means 2 x particle_spacing, and in 2D with surface tension the "
-                      "method's own support, 4 spacings in DFSPH and WCSPH, 2.5 in PBF (docs/surface-tension.md)",
+           atLeast(0,
+                   "SPH kernel radius h; 0 means 2 x particle_spacing, and with surface tension 2.5 spacings "
+                   "in 3D and in 2D the method's own support, 4 spacings in DFSPH and WCSPH, 2.5 in PBF "
+                   "(docs/surface-tension.md)",
                    "m"));
     v.real("rest_density", s.solver.rest_density, positive("rest density rho_0", "kg/m^3"));
     v.real("max_density_error", s.solver.max_density_error,

@@ -239,12 +239,14 @@ void validateWhitewater(Scene& s, const std::string& where) {
     throw InputError(where, "whitewater.bubble_neighbors", "must not be below spray_neighbors");
 }
 
-// solver.kernel_radius 0's support in spacings: 2, or in 2D with surface tension the method's own (where its
-// cohesion lets a drop flow rather than hold as a crystal: SolverMethodEntry::surfaceTensionSupport2d).
+// solver.kernel_radius 0's support in spacings: 2, or with surface tension wider, where the cohesion lets a drop
+// flow and ring rather than hold a set (docs/surface-tension.md): 2.5 in 3D for every method, the method's own in
+// 2D (SolverMethodEntry::surfaceTensionSupport2d).
 double defaultSupport(const Scene& s) {
   const bool tension =
       std::any_of(s.fluids.begin(), s.fluids.end(), [](const FluidBlock& f) { return f.surface_tension > 0; });
-  if (s.dimensions != 2 || !tension) return 2;
+  if (!tension) return 2;
+  if (s.dimensions == 3) return 2.5;
   for (const SolverMethodEntry& method : solverMethodCatalog())
     if (method.name == s.solver.method) return method.surfaceTensionSupport2d;
   return 2;

@@ -4,9 +4,10 @@
 # the share of the step its pass takes (docs/performance.md).
 #
 #   scripts/bench_surface_tension.sh [SURGE_BINARY] [METHOD] [FRAMES] [DIMENSIONS]   (default 20 frames: before
-#   session 58 PBF's drops gained energy by 0.7 s, docs/surface-tension.md; DIMENSIONS 2 runs droplets_2d, whose
-#   default support is the method's own with surface tension and 2 spacings without, and also times it with
-#   surface tension at 2 spacings)
+#   session 58 PBF's drops gained energy by 0.7 s, docs/surface-tension.md; DIMENSIONS 3 runs droplets_zero_g, 2
+#   droplets_2d). With surface tension a scene's default support is wider (2.5 spacings in 3D, the method's own
+#   in 2D) than without (2): the run without takes the run with's radius, so that their steps compare pass for
+#   pass, and a third run times surface tension at 2 spacings.
 set -euo pipefail
 surge=${1:-build/apps/surge}
 method=${2:-dfsph}
@@ -18,8 +19,9 @@ scene=scenes/droplets_zero_g.json
 [ "$dimensions" = 2 ] && scene=scenes/droplets_2d.json
 common=(--set output.frames="$frames" --set solver.method="$method" --set solver.time_step=0.0014 --set solver.substeps=24 --quiet)
 "$surge" sim "$scene" --out "$work/with" "${common[@]}"
+radius=$(grep -o '"kernel_radius": [0-9.e-]*' "$work/with/scene.json" | awk '{ print $2 }')
 "$surge" sim "$scene" --out "$work/without" "${common[@]}" --set fluids[0].surface_tension=0 \
-  --set fluids[1].surface_tension=0 --set fluids[2].surface_tension=0
+  --set fluids[1].surface_tension=0 --set fluids[2].surface_tension=0 --set solver.kernel_radius="$radius"
 # ms a step from stats.csv over frames 1..N: the whole step (wall_seconds), and the forces phase (ms_viscosity),
 # which holds the surface tension pass beside XSPH; and the solver's iterations a step.
 source "$(dirname "${BASH_SOURCE[0]}")/bench_steps.sh"
@@ -34,8 +36,6 @@ awk -v m="$method" -v w="$with" -v o="$without" -v p="$pass" -v x="$xsph" -v iw=
   printf "| method | ms a step with / without | the pass, ms a step | its share of a step | iterations a step with / without |\n"
   printf "|---|---|---|---|---|\n"
   printf "| %s | %.2f / %.2f | %.2f | %.0f%% | %.1f / %.1f |\n", m, w, o, p - x, 100 * (p - x) / w, iw, io }'
-if [ "$dimensions" = 2 ]; then
-  "$surge" sim "$scene" --out "$work/narrow" "${common[@]}" --set solver.kernel_radius=0.002
-  echo "with surface tension at 2 spacings: $(perstep "$work/narrow/stats.csv" wall_seconds) ms a step," \
-    "$(mean "$work/narrow/stats.csv" iterations) iterations a step"
-fi
+"$surge" sim "$scene" --out "$work/narrow" "${common[@]}" --set solver.kernel_radius=0.002
+echo "with surface tension at $radius m of support; at 2 spacings: $(perstep "$work/narrow/stats.csv" wall_seconds)" \
+  "ms a step, $(mean "$work/narrow/stats.csv" iterations) iterations a step"

@@ -141,8 +141,8 @@ struct FluidMethod {
   // densityIterationCap), for surge sim's report and the energy stop's remedy; null for none.
   const char* iterationCapKey = nullptr;
   // Where the adhesion's calibration misses Young's angle in this method in 3D: the test's drop on a plate at
-  // adhesion 0.25, 0.5, 0.75 in degrees, for surge sim's note (docs/surface-tension.md, "By method"); null where it
-  // holds.
+  // adhesion 0.25, 0.5, 0.75 at the 3D default support with surface tension (2.5 spacings), in degrees, for surge
+  // sim's note (docs/surface-tension.md, "By method"); null where it holds.
   const char* adhesionAngles = nullptr;
   // The kernel's support, in spacings, that solver.kernel_radius 0 gives a 2D scene with surface tension: at 2
   // spacings its cohesion holds a 2D drop as a crystal; the method's own width lets it round and ring at

@@ -75,6 +75,6 @@ const FluidMethod kPbfMethod = {"pbf", "Position Based Fluids (Macklin & Mueller
     &makeMethod<PbfSolver, 2>, &makeMethod<PbfSolver, 3>, 250, 400,
     &pbfPushesPerFrame, nullptr, &pbfNotes, &declarePbfKeys,
     "more solver.substeps or solver.iterations (at many steps a frame, a smaller solver.scorr_k: its push is a step's)",
-    true, "solver.iterations", "112, 91, 82", 2.5, "121, 90, 73"};
+    true, "solver.iterations", "116, 96, 76", 2.5, "121, 90, 73"};
 
 }  // namespace surge

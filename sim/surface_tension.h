@@ -11,7 +11,8 @@
 //                        beyond each collider or body with adhesion, tabulated by distance as its walls are
 // gamma is set from sigma (N/m) by Kirkwood and Buff's formula on the rest lattice (tensionPerGamma): the
 // tension of a flat slab of the lattice per unit gamma; beta from `adhesion` a = W_a / (2 sigma), the work of
-// adhesion against the fluid's work of cohesion, by the same sums (Young: cos theta = 2 a - 1).
+// adhesion against the fluid's work of cohesion, by the same sums (Young: cos theta = 2 a - 1), times the share
+// a drop on a plate measures at the kernel's support (adhesionCalibration).
 // Several fluids: each fluid's particles pull together with its own gamma (from its sigma and its particles'
 // mass), and their colour and normals count the same fluid's neighbours only, so each fluid sees another as it
 // sees air and their interface holds sigma_1 + sigma_2; adhesion pulls each fluid by its own sigma.
@@ -34,6 +35,10 @@ namespace surge {
 double sceneSurfaceTension(const Scene& scene);
 // True if some collider or body has adhesion.
 bool sceneHasAdhesion(const Scene& scene);
+// The share of beta (from Young's work of adhesion) with which the drop on a plate meets Young's angle, at a
+// kernel support of `spacings` particle spacings: measured in 3D at 2 (1) and 2.5 (0.75); 0 elsewhere, where
+// beta is taken whole and surge sim notes it (docs/surface-tension.md, "The adhesion by support").
+double adhesionCalibration(int dimensions, double spacings);
 // The most energy surface tension can release into the fluid of `initial` (the scene's lattice at t = 0): sigma
 // times its surface, counted as the lattice cells' faces that have no fluid cell beside them (an upper bound on a
 // smooth shape's area). Infinite with emitters, whose jets bring surface of their own; 0 without tension.

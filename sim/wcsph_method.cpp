@@ -73,6 +73,6 @@ std::vector<std::string> wcsphNotes(const Scene& scene) {
 const FluidMethod kWcsphMethod = {"wcsph", "weakly compressible SPH (Monaghan 1994, Becker & Teschner 2007)",
     &makeMethod<WcsphSolver, 2>, &makeMethod<WcsphSolver, 3>, 250, 400,
     &wcsphPushesPerFrame, nullptr, &wcsphNotes, &declareWcsphKeys,
-    "a smaller solver.cfl or solver.time_step", false, nullptr, "127, 113, 100", 4, "131, 114, 98"};
+    "a smaller solver.cfl or solver.time_step", false, nullptr, "125, 109, 91", 4, "131, 114, 98"};
 
 }  // namespace surge
