@@ -30,7 +30,7 @@ struct SolverSettings {
   std::string method = "pbf";
   int substeps = 0;  // 0 in the file: max(4, stableSubsteps) (resolved)
   int iterations = 4;
-  double kernel_radius = 0;  // 0 in the file: 2 x particle_spacing, wider in 2D with surface tension (resolved on load)
+  double kernel_radius = 0;  // 0 in the file: 2 x particle_spacing, wider with surface tension (resolved on load)
   double rest_density = 1000;
   double relaxation_epsilon = 0.01;
   double warm_start = 0;  // PBF: share of last step's lambda sums applied before the iterations (experimental)
@@ -338,6 +338,9 @@ struct SolverMethodEntry {
   double surfaceTensionSupport2d = 2;  // solver.kernel_radius 0's spacings in 2D with surface tension
 };
 std::vector<SolverMethodEntry>& solverMethodCatalog();
+// solver.kernel_radius 0's support in spacings: 2, or with surface tension wider, where its cohesion lets a drop
+// flow and ring rather than hold a set: 2.5 in 3D, the method's own in 2D (docs/surface-tension.md).
+double defaultKernelSupport(const Scene& scene);
 
 // Lattice points of one fluid box: counts per axis (1 on unused axes in 2D).
 Eigen::Array3i latticeCounts(const Scene& scene, const Box& box);

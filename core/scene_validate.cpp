@@ -239,10 +239,9 @@ void validateWhitewater(Scene& s, const std::string& where) {
     throw InputError(where, "whitewater.bubble_neighbors", "must not be below spray_neighbors");
 }
 
-// solver.kernel_radius 0's support in spacings: 2, or with surface tension wider, where the cohesion lets a drop
-// flow and ring rather than hold a set (docs/surface-tension.md): 2.5 in 3D for every method, the method's own in
-// 2D (SolverMethodEntry::surfaceTensionSupport2d).
-double defaultSupport(const Scene& s) {
+}  // namespace
+
+double defaultKernelSupport(const Scene& s) {
   const bool tension =
       std::any_of(s.fluids.begin(), s.fluids.end(), [](const FluidBlock& f) { return f.surface_tension > 0; });
   if (!tension) return 2;
@@ -251,8 +250,6 @@ double defaultSupport(const Scene& s) {
     if (method.name == s.solver.method) return method.surfaceTensionSupport2d;
   return 2;
 }
-
-}  // namespace
 
 std::vector<double> restNeighborDistances(const Scene& s) {
   const double spacing = s.particle_spacing, h = s.solver.kernel_radius;
@@ -315,7 +312,7 @@ void validateScene(Scene& s, const std::string& where) {
   validateSources(s, where);
 
   SolverSettings& solver = s.solver;
-  if (solver.kernel_radius == 0) solver.kernel_radius = defaultSupport(s) * spacing;
+  if (solver.kernel_radius == 0) solver.kernel_radius = defaultKernelSupport(s) * spacing;
   if (solver.kernel_radius <= spacing)
     throw InputError(where, "solver.kernel_radius", "must exceed particle_spacing, or particles have no neighbours");
   // The neighbour grid covers the particles' box only (sparsely if need be); cell coordinates must fit.

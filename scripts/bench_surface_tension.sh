@@ -37,5 +37,5 @@ awk -v m="$method" -v w="$with" -v o="$without" -v p="$pass" -v x="$xsph" -v iw=
   printf "|---|---|---|---|---|\n"
   printf "| %s | %.2f / %.2f | %.2f | %.0f%% | %.1f / %.1f |\n", m, w, o, p - x, 100 * (p - x) / w, iw, io }'
 "$surge" sim "$scene" --out "$work/narrow" "${common[@]}" --set solver.kernel_radius=0.002
-echo "with surface tension at $radius m of support; at 2 spacings: $(perstep "$work/narrow/stats.csv" wall_seconds)" \
-  "ms a step, $(mean "$work/narrow/stats.csv" iterations) iterations a step"
+printf "with surface tension at %s m of support; at 2 spacings: %.2f ms a step, %s iterations a step\n" "$radius" \
+  "$(perstep "$work/narrow/stats.csv" wall_seconds)" "$(mean "$work/narrow/stats.csv" iterations)"
