@@ -158,9 +158,10 @@ TEST(Colliders, BoxCountsTheLatticeInsideItExactly) {
                    &unused);
     EXPECT_NEAR(weight, exactWeight, 1e-4 * interior) << c.where;
     EXPECT_NEAR((gradient - exactGradient).norm(), 0.0, 1e-4 * interior / h) << c.where;
-    if (c.hydrostatic)
+    if (c.hydrostatic) {
       EXPECT_NEAR((colliders.hydrostaticSum(0, p, d, n, gravity) - exactHydrostatic).norm(), 0.0,
                   1e-4 * interior * 9.81) << c.where;
+    }
     float flatWeight, flatGradient;
     sphRestLattice<3>(scene).walls.flatWall().lookup(d, flatWeight, flatGradient);
     std::printf("%-32s weight %.4f of the interior sum (exact %.4f, a flat wall at the nearest point %.4f)\n",
