@@ -250,27 +250,20 @@ std::vector<std::string> solverNotes(const Scene& scene) {
                     " degrees at adhesion 0.25, 0.5, 0.75, where Young's angle is 120, 90, 60" + elsewhere +
                     " (docs/surface-tension.md)");
   }
-  // In 2D, cohesion over 2 spacings of support holds the lattice as a crystal; the method's own width, which
-  // solver.kernel_radius 0 gives, lets a drop round (docs/surface-tension.md, "The 2D support").
-  if (scene.dimensions == 2 && sceneSurfaceTension(scene) > 0 && support < 2.75 && support < own - 1e-9) {
+  // Cohesion over 2 spacings of support holds the lattice: in 2D as a crystal, in 3D in a set; the default's
+  // wider support (defaultKernelSupport) lets a drop round and ring (docs/surface-tension.md, "The 2D support",
+  // "The 3D support"). In 2D a support from 2.75 spacings up rounds a drop too.
+  if (sceneSurfaceTension(scene) > 0 && support < std::min(own, 2.75) - 1e-9) {
+    const bool flat = scene.dimensions == 2;
     char text[400];
     std::snprintf(text, sizeof text,
-                  "surface tension in 2D with %.3g spacings of kernel support holds the particles as a crystal: a drop "
-                  "keeps its shape instead of rounding; solver.kernel_radius 0 gives %s %.3g spacings (%g here), "
-                  "with which it rounds (docs/surface-tension.md)",
-                  support, name.c_str(), own, own * scene.particle_spacing);
-    notes.push_back(text);
-  }
-  // In 3D it holds a set; 2.5 spacings, which solver.kernel_radius 0 gives, lets a drop round and ring
-  // (docs/surface-tension.md, "The 3D support").
-  if (scene.dimensions == 3 && sceneSurfaceTension(scene) > 0 && support < own - 1e-9) {
-    char text[400];
-    std::snprintf(text, sizeof text,
-                  "surface tension in 3D with %.3g spacings of kernel support holds the particles in a set: at 2 a "
-                  "2:1:1 box of water stays 2.3%% off round and a drop does not ring at Rayleigh's frequency; "
-                  "solver.kernel_radius 0 gives %.3g spacings (%g here), with which they do "
-                  "(docs/surface-tension.md)",
-                  support, own, own * scene.particle_spacing);
+                  "surface tension in %dD with %.3g spacings of kernel support holds the particles %s; "
+                  "solver.kernel_radius 0 gives %s%.3g spacings (%g here), with which %s (docs/surface-tension.md)",
+                  scene.dimensions, support,
+                  flat ? "as a crystal: a drop keeps its shape instead of rounding"
+                       : "in a set: at 2 a 2:1:1 box of water stays 2.3% off round and a drop does not ring at "
+                         "Rayleigh's frequency",
+                  flat ? (name + " ").c_str() : "", own, own * scene.particle_spacing, flat ? "it rounds" : "they do");
     notes.push_back(text);
   }
   // The transport velocity pushes particles out of a free surface.
