@@ -388,10 +388,11 @@ void DfsphSolver<Dim>::recordColliderImpulses(const std::vector<float>& lambda, 
 }
 
 template <int Dim>
-std::vector<float> DfsphSolver<Dim>::pressures() const {
+std::vector<float> DfsphSolver<Dim>::pressures(bool withDivergence) const {
   std::vector<float> p(size(), 0.0f);
   if (lastStep_ > 0)
-    for (size_t i = 0; i < size(); ++i) p[i] = restDensity_ * densityWarm_[i] / (lastStep_ * lastStep_);
+    for (size_t i = 0; i < size(); ++i)
+      p[i] = restDensity_ * (densityWarm_[i] + (withDivergence ? divergenceWarm_[i] : 0.0f)) / (lastStep_ * lastStep_);
   return p;
 }
 

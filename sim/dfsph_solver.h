@@ -64,9 +64,12 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   int lastDivergenceIterations() const override { return divergenceIterations_; }
   // The largest pressure of the frame's density solves, p_i = rho_0 lambda_i / dt^2.
   float maxPressure() const override { return framePressureMax_; }
-  // Each particle's pressure in the last step's density solve, rho_0 lambda_i / dt^2, in the current order.
-  std::vector<float> pressures() const;
-  std::vector<float> virialPressures() override { return this->pairVirialPressures(kernel_, pressures(), {}); }
+  // Each particle's pressure in the last step's density solve, rho_0 lambda_i / dt^2, in the current order; with
+  // `withDivergence`, plus the divergence solve's (the same form): the whole pressure force of the step.
+  std::vector<float> pressures(bool withDivergence = false) const;
+  // Both solves' pressures: without the divergence solve's, a drop at rest summed to -0.27 Pa, not zero
+  // (docs/surface-tension.md, "Laplace's pressure").
+  std::vector<float> virialPressures() override { return this->pairVirialPressures(kernel_, pressures(true), {}); }
 
  private:
   using Core = ParticleSolver<Dim>;

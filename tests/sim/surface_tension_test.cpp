@@ -190,10 +190,11 @@ TEST(SurfaceTension, A2DDropOscillatesAtRayleighsFrequencyInWcsphAtItsDefaults) 
 // fluid against the cohesion's pull, of order sigma / h, so the pressure Laplace's law speaks of is the mechanical
 // one, the virial of every pair force (FluidSolver::virialPressures). DFSPH 3D at its default support with surface
 // tension (2.5 spacings), R = 20 mm (40 particles across), the particles within R/2 over 0.2 s: within the issue's
-// 10% of 2 sigma / R (measured 1.043; a probe read 1.18, 1.17, 1.13, 1.06 and 1.05 at 8, 10, 12, 16 and 20 mm: the
+// 10% of 2 sigma / R (measured 1.064; a probe read 1.18, 1.17, 1.13, 1.06 and 1.05 at 8, 10, 12, 16 and 20 mm: the
 // excess falls as 1/R, and at 16 mm this procedure reads 1.087, too near the bound; docs/surface-tension.md).
-// Over the whole drop the virial of a system at rest sums to zero: held to a tenth of Laplace's, so that the
-// interior's figure is not an offset of the measure.
+// Over the whole drop the virial of a system at rest sums to zero, less twice its kinetic energy: held to 2% of
+// Laplace's (measured -0.3%), so that every pressure force is in the measure. Without DFSPH's divergence solve's
+// pressure it read -3.7%.
 TEST(SurfaceTension, ADropsInnerPressureIsLaplacesInDfsph3DAtItsDefaults) {
   const double radius = 0.02, laplace = 2 * kSigma / radius;
   auto solver = makeFluidSolver<3>(dropScene(3, "dfsph", radius));
@@ -224,7 +225,7 @@ TEST(SurfaceTension, ADropsInnerPressureIsLaplacesInDfsph3DAtItsDefaults) {
   std::printf("inside %.3f Pa (%.3f of 2 sigma / R = %.3f Pa), the whole drop's mean %.3f Pa\n", inside,
               inside / laplace, laplace, whole);
   EXPECT_NEAR(inside / laplace, 1.0, 0.1);
-  EXPECT_LT(std::abs(whole), 0.1 * laplace);
+  EXPECT_LT(std::abs(whole), 0.02 * laplace);
 }
 
 // The 2:1:1 box of water (24 x 12 x 12 particles at 1 mm) in zero gravity, in `method`.
