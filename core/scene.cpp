@@ -369,7 +369,7 @@ class KeyTable : public SceneVisitor {
     row(key, "integer", std::to_string(value), info);
   }
   void real(const char* key, double& value, const FieldInfo& info) override {
-    row(key, "number", formatNumber(value), info);
+    row(key, "number", std::isnan(value) ? "" : formatNumber(value), info);  // NaN: resolved, as described
   }
   void vector(const char* key, Eigen::Vector3d& value, const FieldInfo& info, bool always3) override {
     std::string text = "[" + formatNumber(value[0]) + ", " + formatNumber(value[1]) + ", " + formatNumber(value[2]) + "]";

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -29,7 +30,7 @@ inline const std::vector<std::string>& tankFaceNames() {
 struct SolverSettings {
   std::string method = "pbf";
   int substeps = 0;  // 0 in the file: max(4, stableSubsteps) (resolved)
-  int iterations = 4;
+  int iterations = 0;        // PBF; 0 in the file: 4, or 30 where the fluids' densities differ (resolved on load)
   double kernel_radius = 0;  // 0 in the file: 2 x particle_spacing, wider with surface tension (resolved on load)
   double rest_density = 1000;
   double relaxation_epsilon = 0.01;
@@ -40,7 +41,9 @@ struct SolverSettings {
   double max_density_error = 0;  // > 0: iterate until the average density error is under it (DFSPH: 0 means 0.0005)
   double max_divergence_error = 0.001;  // DFSPH's divergence solver: average density change a step would cause
   int max_iterations = 100;             // DFSPH: the most iterations of each of its solvers a step
-  double scorr_k = 0.1;          // artificial pressure (PBF eq. 13-14); 0 turns it off
+  // PBF eq. 13-14's artificial pressure; 0 turns it off. Left out (NaN): 0.1, or in PBF 0 where the fluids'
+  // densities differ (resolved on load).
+  double scorr_k = std::numeric_limits<double>::quiet_NaN();
   int scorr_n = 4;
   double scorr_delta_q = 0.2;  // as a fraction of the kernel radius
   double vorticity_epsilon = 0;  // vorticity confinement (eq. 15-16); 0 turns it off
@@ -287,6 +290,8 @@ struct Scene {
   size_t emittedFluid(size_t emitter) const;
   // True when the blocks name more than one fluid: the particles then carry their fluid.
   bool severalFluids() const;
+  // True when some fluid's rest density is not the first's (a density contrast: docs/several-fluids.md).
+  bool densitiesDiffer() const;
   // The first block of every fluid after the first, in order (none in a scene of one fluid).
   std::vector<size_t> laterFluids() const;
   // The rest density of the particles that are not told apart: the first block's, or solver.rest_density

@@ -285,9 +285,11 @@ void visitScene(Scene& s, SceneVisitor& v) {
                    "m"));
     v.real("rest_density", s.solver.rest_density, positive("rest density rho_0", "kg/m^3"));
     v.real("max_density_error", s.solver.max_density_error,
-           atLeast(0, "PBF: when > 0, iterate until the average density error (a fraction) is under it, at most "
-                      "`iterations` times; 0 runs exactly `iterations`. DFSPH: its density solver's limit on the "
-                      "average predicted compression; 0 means 0.0005"));
+           atLeast(0,
+                   "PBF: when > 0, iterate until the average density error (a fraction) is under it, at most "
+                   "`iterations` times; 0 runs exactly `iterations` (where the fluids' densities differ and "
+                   "`iterations` is left out: 0.001). DFSPH: its density solver's limit on the average predicted "
+                   "compression; 0 means 0.0005"));
     v.real("xsph_c", s.solver.xsph_c,
            atLeast(0, "PBF eq. 17 XSPH viscosity c (weights scaled by the particle volume), also DFSPH's; 0 turns "
                       "it off", "", 1));

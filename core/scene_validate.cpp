@@ -343,6 +343,10 @@ void validateScene(Scene& s, const std::string& where) {
 
   // The simulator's defaults (sim/solver_defaults.cpp), where the program has the simulator.
   if (solverDefaults()) solverDefaults()(s);
+  // PBF's keys where its own defaults (where the fluids' densities differ) left them unset, and in every other
+  // scene, whose scene.json writes them too: 4 iterations and s_corr 0.1.
+  if (s.solver.iterations == 0) s.solver.iterations = 4;
+  if (std::isnan(s.solver.scorr_k)) s.solver.scorr_k = 0.1;
 }
 
 Eigen::Array3i latticeCounts(const Scene& scene, const Box& box) {
@@ -370,6 +374,11 @@ bool Scene::severalFluids() const {
   for (size_t i = 1; i < fluids.size(); ++i)
     if (fluids[i].name != fluids[0].name) return true;
   return false;
+}
+
+bool Scene::densitiesDiffer() const {
+  return std::any_of(fluids.begin(), fluids.end(),
+                     [&](const FluidBlock& f) { return f.rest_density != referenceDensity(); });
 }
 
 std::vector<size_t> Scene::laterFluids() const {

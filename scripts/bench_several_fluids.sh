@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The cost of several fluids (issue 34): oil_and_water as it ships (oil at 900 kg/m^3 on water) beside the same
 # blocks as one fluid (both named water, at 1000), run one after the other in this script, in each method (PBF at
-# its 8 steps a frame and 4 iterations; DFSPH and WCSPH at their own steps), so that the time a step compares step
-# for step; the share of a step the inverse-mass weighting adds (docs/several-fluids.md). Each run three times,
-# the fastest kept (a shared machine).
+# its 8 steps a frame, 4 iterations and s_corr 0.1 in both; DFSPH and WCSPH at their own steps), so that the time a
+# step compares step for step; the share of a step the inverse-mass weighting adds (docs/several-fluids.md). Then
+# PBF's two fluids at its defaults for differing densities (at most 30 iterations to 0.1%, no s_corr) against the
+# pinned run: what the converged solve costs. Each run three times, the fastest kept (a shared machine).
 #
 #   scripts/bench_several_fluids.sh [SURGE_BINARY] [FRAMES]
 #   METHODS="pbf dfsph" scripts/bench_several_fluids.sh ...   (a subset of the methods)
@@ -23,9 +24,16 @@ best() {  # best NAME ARGS...: the fastest of three runs' ms a step, and its con
 echo "| method | one fluid, ms a step | two fluids | ratio | pressure phase, one | two |"
 echo "|---|---|---|---|---|---|"
 for method in ${METHODS:-pbf dfsph wcsph}; do
-  read -r two twoPhase < <(best two --set solver.method="$method")
-  read -r one onePhase < <(best one --set solver.method="$method" --set 'fluids[1].name=water' \
+  pin=()
+  [[ $method == pbf ]] && pin=(--set solver.iterations=4 --set solver.scorr_k=0.1)
+  read -r two twoPhase < <(best two --set solver.method="$method" "${pin[@]}")
+  read -r one onePhase < <(best one --set solver.method="$method" "${pin[@]}" --set 'fluids[1].name=water' \
     --set 'fluids[1].rest_density=1000' --set 'fluids[1].color=[0.15,0.45,0.8]')
   awk -v m="$method" -v t="$two" -v o="$one" -v tp="$twoPhase" -v op="$onePhase" \
     'BEGIN { printf "| %s | %.2f | %.2f | %.3f | %.2f | %.2f |\n", m, o, t, t / o, op, tp }'
+  if [[ $method == pbf ]]; then
+    read -r own ownPhase < <(best own --set solver.method=pbf)
+    awk -v t="$two" -v c="$own" -v cp="$ownPhase" 'BEGIN { printf "\nPBF, two fluids at its defaults (at most 30 '\
+'iterations to 0.1%%, no s_corr): %.2f ms a step, its constraint phase %.2f; %.2f times the run at 4 iterations\n\n", c, cp, c / t }'
+  fi
 done

@@ -1,6 +1,7 @@
 // PBF's registration (sim/fluid_solver.h): its own scene keys, the defaults and notes it adds, and what it
 // asks of a scene, beside its solver (sim/pbf_solver.h).
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -14,7 +15,11 @@ namespace {
 // The method's own keys under `solver` (its registration hands them to the scene reader).
 void declarePbfKeys(SceneVisitor& v, SolverSettings& s) {
   using field::atLeast, field::info, field::positive;
-  v.integer("iterations", s.iterations, atLeast(1, "PBF: Jacobi iterations per step", "", 10000));
+  v.integer("iterations", s.iterations,
+            atLeast(0,
+                    "PBF: Jacobi iterations per step; 0: 4, or where the fluids' densities differ at most 30, to "
+                    "max_density_error (0.001 if 0; docs/several-fluids.md)",
+                    "", 10000));
   v.real("relaxation_epsilon", s.relaxation_epsilon,
          atLeast(0, "PBF eq. 11 relaxation epsilon, as a fraction of the rest lattice's sum of squared "
                     "constraint gradients (0.01 softens the constraint by 1%)"));
@@ -29,8 +34,10 @@ void declarePbfKeys(SceneVisitor& v, SolverSettings& s) {
                     "fewer iterations for the same density error, up to where it overshoots (0.95 blows a dam "
                     "break up; docs/speed-accuracy.md); 0 turns it off", "", 0.95));
   v.real("scorr_k", s.scorr_k,
-         atLeast(0, "PBF eq. 13 artificial pressure k, in units of the rest lattice's lambda; 0 turns s_corr off (as "
-                    "a domain periodic along every axis does: no spray or sheets there)"));
+         atLeast(0,
+                 "PBF eq. 13 artificial pressure k, in units of the rest lattice's lambda; 0 turns s_corr off (as "
+                 "a domain periodic along every axis does: no spray or sheets there); left out: 0.1, or 0 where "
+                 "the fluids' densities differ"));
   v.integer("scorr_n", s.scorr_n, atLeast(1, "PBF eq. 13 exponent n", "", 16));
   {
     FieldInfo dq = positive("PBF eq. 13 delta q, as a fraction of the kernel radius (paper: 0.1 to 0.3)");
@@ -39,6 +46,21 @@ void declarePbfKeys(SceneVisitor& v, SolverSettings& s) {
   }
   v.real("vorticity_epsilon", s.vorticity_epsilon,
          atLeast(0, "PBF eq. 16 vorticity confinement epsilon; 0 turns it off", "m/s"));
+}
+
+// Where the fluids' densities differ PBF iterates to a density error of 0.1% (at most 30 iterations) without
+// s_corr, unless the file says otherwise: under 4 fixed iterations a heavy column sags for 0.05 s before its
+// pressure holds it, and s_corr's push, a step's, holds the converged interior against the flow. Rayleigh-Taylor's
+// growth read 0.60 to 0.84 of theory at 4 to 32 steps a frame with them, 0.86 to 0.95 without
+// (docs/several-fluids.md).
+void resolvePbfDefaults(Scene& scene) {
+  if (!scene.densitiesDiffer()) return;
+  SolverSettings& s = scene.solver;
+  if (s.iterations == 0) {
+    s.iterations = 30;
+    if (s.max_density_error == 0) s.max_density_error = 0.001;
+  }
+  if (std::isnan(s.scorr_k)) s.scorr_k = 0;
 }
 
 // The projection moves a particle up to about a spacing a step (the velocity is that move over the step).
@@ -58,6 +80,16 @@ std::vector<std::string> pbfNotes(const Scene& scene) {
     notes.push_back("solver.kernel_radius is " + formatNumber(spacings) + " spacings: PBF's kernels wider than 2.5 "
                     "spacings stir a fluid at rest (a 2D pool at 3 keeps six times the kinetic energy it keeps at 2; "
                     "at 3.5 it gains energy until the energy check stops it)");
+  // Where the fluids' densities differ, the settings their defaults avoid (resolvePbfDefaults).
+  if (scene.densitiesDiffer() && scene.solver.max_density_error == 0)
+    notes.push_back("solver.iterations " + std::to_string(scene.solver.iterations) +
+                    " fixed where the fluids' densities differ: a heavy column sags under fixed iterations before its "
+                    "pressure holds it (a Rayleigh-Taylor mode grows at 0.75 of theory at 4); left out, PBF "
+                    "iterates to a density error of 0.1%, at most 30 times a step");
+  if (scene.densitiesDiffer() && scene.solver.scorr_k > 0)
+    notes.push_back("solver.scorr_k where the fluids' densities differ: s_corr's push, a step's, holds the interior "
+                    "against the flow (a Rayleigh-Taylor mode grows at 0.60 of theory at 32 steps a frame); left out, "
+                    "it is 0 in such a scene");
   // PBF's push keeps a flow's particles even (a Taylor-Green vortex within 2.3%), but stirs a fluid at rest.
   if (scene.solver.background_pressure > 0)
     notes.push_back("solver.background_pressure in PBF keeps a flow's particles even but stirs a fluid at rest: a "
@@ -73,7 +105,7 @@ std::vector<std::string> pbfNotes(const Scene& scene) {
 // (docs/performance.md).
 const FluidMethod kPbfMethod = {"pbf", "Position Based Fluids (Macklin & Mueller 2013)",
     &makeMethod<PbfSolver, 2>, &makeMethod<PbfSolver, 3>, 250, 400,
-    &pbfPushesPerFrame, nullptr, &pbfNotes, &declarePbfKeys,
+    &pbfPushesPerFrame, &resolvePbfDefaults, &pbfNotes, &declarePbfKeys,
     "more solver.substeps or solver.iterations (at many steps a frame, a smaller solver.scorr_k: its push is a step's)",
     true, "solver.iterations", "116, 96, 76", 2.5, "121, 90, 73"};
 

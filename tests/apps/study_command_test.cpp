@@ -129,7 +129,7 @@ TEST(StudyCommand, BadSweepsAreRefusedBeforeAnythingIsWritten) {
   const fs::path out = fs::path(testing::TempDir()) / "surge_study_bad";
   fs::remove_all(out);
   for (const std::string sweep : {"solver.iterations", "=1,2", "solver.iterations=1,,2", "solver.no_such_key=1,2",
-                                  "solver.iterations=1,0", "surface.method=spheres,anisotropic"}) {
+                                  "solver.iterations=1,-1", "surface.method=spheres,anisotropic"}) {
     const SurgeResult r = runSurge("study '" + scene.string() + "' --quiet --sweep '" + sweep + "' --out " + out.string());
     EXPECT_EQ(r.status, 2) << sweep << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

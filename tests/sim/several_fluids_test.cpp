@@ -12,6 +12,7 @@
 #include "core/files.h"
 #include "core/ply.h"
 #include "core/scene.h"
+#include "sim/solver_defaults.h"
 #include "tests/sim/run_scene.h"
 
 namespace surge {
@@ -228,6 +229,45 @@ TEST(SeveralFluids, BadInputNamesTheKey) {
   EXPECT_EQ(errorOf("[{" + box + R"(}, {)" + box + R"(, "name": "oil", "rest_density": 800}])", "dfsph"), "no error");
   EXPECT_NE(errorOf("[{" + box + R"(}, {)" + box + R"(, "color": [1, 0, 0]}])").find("fluids[1].color"),
             std::string::npos);
+}
+
+// Where the fluids' densities differ PBF iterates to a density error of 0.1% (at most 30 times) without s_corr,
+// unless the file sets them (resolvePbfDefaults; RayleighTaylor.OneModeGrowsAtTheLinearRate measures why); in a
+// scene of one density, and in the other methods, its keys keep 4 iterations and s_corr 0.1, as before. surge sim
+// notes the settings that default avoids where a file sets them.
+TEST(SeveralFluids, PbfConvergesWithoutScorrWhereTheDensitiesDiffer) {
+  const auto scene = [](const std::string& method, const std::string& oil, const std::vector<std::string>& extra) {
+    return parseScene(R"({"name": "layers", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.4, 0.4]},
+      "particle_spacing": 0.02, "solver": {"method": ")" +
+                          method + R"("},
+      "fluids": [{"box": {"min": [0, 0], "max": [0.4, 0.1]}},
+                 {"name": "oil", )" +
+                          oil + R"("box": {"min": [0, 0.1], "max": [0.4, 0.2]}}]})",
+                      "layers.json", extra);
+  };
+  const auto expectSettings = [](const Scene& s, int iterations, double error, double scorr) {
+    EXPECT_EQ(s.solver.iterations, iterations);
+    EXPECT_DOUBLE_EQ(s.solver.max_density_error, error);
+    EXPECT_DOUBLE_EQ(s.solver.scorr_k, scorr);
+  };
+  const std::string oil = R"("rest_density": 800, )";
+  expectSettings(scene("pbf", oil, {}), 30, 0.001, 0);
+  expectSettings(scene("pbf", "", {}), 4, 0, 0.1);  // two fluids of one density
+  expectSettings(scene("pbf", oil, {"solver.iterations=6"}), 6, 0, 0);
+  expectSettings(scene("pbf", oil, {"solver.scorr_k=0.1"}), 30, 0.001, 0.1);
+  expectSettings(scene("pbf", oil, {"solver.max_density_error=0.01"}), 30, 0.01, 0);
+  expectSettings(scene("dfsph", oil, {}), 4, 0.0005, 0.1);  // max_density_error: DFSPH's own
+  const Scene resolved = scene("pbf", oil, {});
+  EXPECT_EQ(sceneToJson(parseScene(sceneToJson(resolved), "scene.json")), sceneToJson(resolved));
+
+  const auto notesWith = [&](const std::vector<std::string>& extra, const std::string& text) {
+    int count = 0;
+    for (const std::string& note : solverNotes(scene("pbf", oil, extra))) count += note.find(text) != std::string::npos;
+    return count;
+  };
+  EXPECT_EQ(notesWith({}, "where the fluids' densities differ"), 0);
+  EXPECT_EQ(notesWith({"solver.iterations=4"}, "solver.iterations 4 fixed where the fluids' densities differ"), 1);
+  EXPECT_EQ(notesWith({"solver.scorr_k=0.1"}, "solver.scorr_k where the fluids' densities differ"), 1);
 }
 
 }  // namespace

@@ -168,10 +168,10 @@ TEST(SolverDefaults, AMethodsOwnKeysRoundTripThroughSceneJson) {
   EXPECT_EQ(again.solver.max_iterations, 9);
   EXPECT_EQ(sceneToJson(again), sceneToJson(scene));
   try {
-    parseScene(kValid, "s", {"solver.iterations=0"});
+    parseScene(kValid, "s", {"solver.iterations=-1"});
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "--set: solver.iterations: 0 is out of range (>= 1, <= 10000)");
+    EXPECT_STREQ(e.what(), "--set: solver.iterations: -1 is out of range (>= 0, <= 10000)");
   }
 }
 
