@@ -33,7 +33,9 @@ for method in ${METHODS:-pbf dfsph wcsph}; do
     'BEGIN { printf "| %s | %.2f | %.2f | %.3f | %.2f | %.2f |\n", m, o, t, t / o, op, tp }'
   if [[ $method == pbf ]]; then
     read -r own ownPhase < <(best own --set solver.method=pbf)
-    awk -v t="$two" -v c="$own" -v cp="$ownPhase" 'BEGIN { printf "\nPBF, two fluids at its defaults (at most 30 '\
-'iterations to 0.1%%, no s_corr): %.2f ms a step, its constraint phase %.2f; %.2f times the run at 4 iterations\n\n", c, cp, c / t }'
+    converged=$(awk -v t="$two" -v c="$own" -v cp="$ownPhase" 'BEGIN { printf "PBF, two fluids at its defaults (at '\
+'most 30 iterations to 0.1%%, no s_corr): %.2f ms a step, its constraint phase %.2f; %.2f times the run at 4 '\
+'iterations", c, cp, c / t }')
   fi
 done
+[[ -n ${converged:-} ]] && printf '\n%s\n' "$converged"
