@@ -42,7 +42,7 @@ struct SolverSettings {
   double max_divergence_error = 0.001;  // DFSPH's divergence solver: average density change a step would cause
   int max_iterations = 100;             // DFSPH: the most iterations of each of its solvers a step
   // PBF eq. 13-14's artificial pressure; 0 turns it off. Left out (NaN): 0.1, or in PBF 0 where the fluids'
-  // densities differ (resolved on load).
+  // densities differ without surface tension (resolved on load).
   double scorr_k = std::numeric_limits<double>::quiet_NaN();
   int scorr_n = 4;
   double scorr_delta_q = 0.2;  // as a fraction of the kernel radius

@@ -232,9 +232,10 @@ TEST(SeveralFluids, BadInputNamesTheKey) {
 }
 
 // Where the fluids' densities differ PBF iterates to a density error of 0.1% (at most 30 times) without s_corr,
-// unless the file sets them (resolvePbfDefaults; RayleighTaylor.OneModeGrowsAtTheLinearRate measures why); in a
-// scene of one density, and in the other methods, its keys keep 4 iterations and s_corr 0.1, as before. surge sim
-// notes the settings that default avoids where a file sets them.
+// unless the file sets them (resolvePbfDefaults; RayleighTaylor.OneModeGrowsAtTheLinearRate measures why), and
+// keeps s_corr where a fluid has surface tension (AnOilRectangleInWaterRoundsInEveryMethod); in a scene of one
+// density, and in the other methods, its keys keep 4 iterations and s_corr 0.1, as before. surge sim notes the
+// settings that default avoids where a file sets them.
 TEST(SeveralFluids, PbfConvergesWithoutScorrWhereTheDensitiesDiffer) {
   const auto scene = [](const std::string& method, const std::string& oil, const std::vector<std::string>& extra) {
     return parseScene(R"({"name": "layers", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.4, 0.4]},
@@ -257,15 +258,20 @@ TEST(SeveralFluids, PbfConvergesWithoutScorrWhereTheDensitiesDiffer) {
   expectSettings(scene("pbf", oil, {"solver.scorr_k=0.1"}), 30, 0.001, 0.1);
   expectSettings(scene("pbf", oil, {"solver.max_density_error=0.01"}), 30, 0.01, 0);
   expectSettings(scene("dfsph", oil, {}), 4, 0.0005, 0.1);  // max_density_error: DFSPH's own
+  const std::string oilWithTension = R"("rest_density": 800, "surface_tension": 0.03, )";
+  expectSettings(scene("pbf", oilWithTension, {}), 30, 0.001, 0.1);
   const Scene resolved = scene("pbf", oil, {});
   EXPECT_EQ(sceneToJson(parseScene(sceneToJson(resolved), "scene.json")), sceneToJson(resolved));
 
-  const auto notesWith = [&](const std::vector<std::string>& extra, const std::string& text) {
+  const auto notesWith = [&](const std::vector<std::string>& extra, const std::string& text,
+                             const std::string& oilBlock = R"("rest_density": 800, )") {
     int count = 0;
-    for (const std::string& note : solverNotes(scene("pbf", oil, extra))) count += note.find(text) != std::string::npos;
+    for (const std::string& note : solverNotes(scene("pbf", oilBlock, extra)))
+      count += note.find(text) != std::string::npos;
     return count;
   };
   EXPECT_EQ(notesWith({}, "where the fluids' densities differ"), 0);
+  EXPECT_EQ(notesWith({}, "where the fluids' densities differ", oilWithTension), 0);
   EXPECT_EQ(notesWith({"solver.iterations=4"}, "solver.iterations 4 fixed where the fluids' densities differ"), 1);
   EXPECT_EQ(notesWith({"solver.scorr_k=0.1"}, "solver.scorr_k where the fluids' densities differ"), 1);
 }

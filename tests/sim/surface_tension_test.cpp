@@ -394,8 +394,9 @@ TEST(SurfaceTension, SameBytesAtAnyThreadCountAndAfterAResume) {
 // sigma_1 + sigma_2 (sim/surface_tension.h). A 2:1 rectangle of oil (rho 900, sigma 0.03, 30 x 15 particles)
 // inside water (sigma 0.0728) in zero gravity starts at anisotropy 0.60 and rounds in every method to the issue's
 // 2% (by 1 s in WCSPH, 2 s in the others), at the default support of a 2D scene with surface tension
-// (FluidMethod::surfaceTensionSupport2d). Measured: DFSPH 0.238 at 1 s, 0.012 at 2 s; PBF 0.017 and 0.016; WCSPH 0.003
-// at 1 s. At 2 spacings each kept a set (DFSPH 0.47, PBF 0.28, WCSPH 0.53 at 1 s: the crystal,
+// (FluidMethod::surfaceTensionSupport2d). Measured: DFSPH 0.238 at 1 s, 0.012 at 2 s; PBF 0.014 and 0.018 (at its
+// defaults where the densities differ: converged, s_corr kept with surface tension; 0.024 and 0.031 without s_corr);
+// WCSPH 0.003 at 1 s. At 2 spacings each kept a set (DFSPH 0.47, PBF 0.28, WCSPH 0.53 at 1 s: the crystal,
 // docs/surface-tension.md). Without the sigmas the rectangle keeps 0.601 to 1e-3. In DFSPH the run is the same bytes at
 // 1 and 2 threads and after a resume.
 Scene oilInWater(const std::string& method, bool tension) {
