@@ -49,6 +49,11 @@ void declarePbfKeys(SceneVisitor& v, SolverSettings& s) {
          atLeast(0, "PBF eq. 16 vorticity confinement epsilon; 0 turns it off", "m/s"));
 }
 
+// Where s_corr is off unless the file sets it: the fluids' densities differ and none has surface tension.
+bool scorrOffByDefault(const Scene& scene) {
+  return scene.densitiesDiffer() && sceneSurfaceTension(scene) == 0;
+}
+
 // Where the fluids' densities differ PBF iterates to a density error of 0.1% (at most 30 iterations), and without
 // surface tension leaves s_corr off, unless the file says otherwise: under 4 fixed iterations a heavy column sags
 // for 0.05 s before its pressure holds it, and s_corr's push, a step's, holds the converged interior against the
@@ -62,7 +67,7 @@ void resolvePbfDefaults(Scene& scene) {
     s.iterations = 30;
     if (s.max_density_error == 0) s.max_density_error = 0.001;
   }
-  if (std::isnan(s.scorr_k) && sceneSurfaceTension(scene) == 0) s.scorr_k = 0;
+  if (std::isnan(s.scorr_k) && scorrOffByDefault(scene)) s.scorr_k = 0;
 }
 
 // The projection moves a particle up to about a spacing a step (the velocity is that move over the step).
@@ -88,7 +93,7 @@ std::vector<std::string> pbfNotes(const Scene& scene) {
                     " fixed where the fluids' densities differ: a heavy column sags under fixed iterations before its "
                     "pressure holds it (a Rayleigh-Taylor mode grows at 0.75 of theory at 4); left out, PBF "
                     "iterates to a density error of 0.1%, at most 30 times a step");
-  if (scene.densitiesDiffer() && scene.solver.scorr_k > 0 && sceneSurfaceTension(scene) == 0)
+  if (scorrOffByDefault(scene) && scene.solver.scorr_k > 0)
     notes.push_back("solver.scorr_k where the fluids' densities differ: s_corr's push, a step's, holds the interior "
                     "against the flow (a Rayleigh-Taylor mode grows at 0.60 of theory at 32 steps a frame); left out, "
                     "it is 0 in such a scene");
