@@ -56,7 +56,9 @@ struct SolverSettings {
   std::string integrator = "velocity_verlet";  // or "symplectic_euler"
   double time_step = 0;                  // > 0: a fixed step; 0: from the CFL, viscous and force limits
   double cfl = 0.4;
-  double artificial_viscosity = 0.05;    // Monaghan's alpha; 0 turns it off
+  // Monaghan's alpha; 0 turns it off. Left out (NaN): 0.05, or 0.01 in WCSPH in a 3D scene with surface tension
+  // (resolved on load).
+  double artificial_viscosity = std::numeric_limits<double>::quiet_NaN();
   double kinematic_viscosity = 0;        // laminar nu (m^2/s); 0 turns it off
   double near_pressure = 0;              // Clavet et al. 2005 near-pressure stiffness; 0 turns it off
   double background_pressure = 0;        // Adami et al. 2013's transport velocity (Pa); 0 turns it off

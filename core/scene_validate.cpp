@@ -343,10 +343,12 @@ void validateScene(Scene& s, const std::string& where) {
 
   // The simulator's defaults (sim/solver_defaults.cpp), where the program has the simulator.
   if (solverDefaults()) solverDefaults()(s);
-  // PBF's keys where its own defaults (where the fluids' densities differ) left them unset, and in every other
-  // scene, whose scene.json writes them too: 4 iterations and s_corr 0.1.
+  // The methods' keys where their own defaults (PBF where the fluids' densities differ, WCSPH with surface tension
+  // in 3D) left them unset, and in every other scene, whose scene.json writes them too: 4 iterations, s_corr 0.1,
+  // alpha 0.05.
   if (s.solver.iterations == 0) s.solver.iterations = 4;
   if (std::isnan(s.solver.scorr_k)) s.solver.scorr_k = 0.1;
+  if (std::isnan(s.solver.artificial_viscosity)) s.solver.artificial_viscosity = 0.05;
 }
 
 Eigen::Array3i latticeCounts(const Scene& scene, const Box& box) {

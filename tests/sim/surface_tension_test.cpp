@@ -174,6 +174,27 @@ TEST(SurfaceTension, AThreeDimensionalDropOscillatesAtRayleighsFrequencyInDfsphA
   expectRayleighsFrequency<3>("dfsph", {});
 }
 
+// WCSPH 3D takes alpha 0.01 with surface tension (resolveWcsphDefaults): measured 0.951 and 0.959. At alpha 0.05,
+// its default elsewhere, the drop rings at 0.856 and 0.860 of Rayleigh's half period and the test fails.
+TEST(SurfaceTension, AThreeDimensionalDropOscillatesAtRayleighsFrequencyInWcsphAtItsDefaults) {
+  expectRayleighsFrequency<3>("wcsph", {});
+}
+
+// WCSPH's artificial viscosity left out is 0.01 in a 3D scene with surface tension and 0.05 in any other (2D with
+// surface tension, 3D without), as in every other method's scene.json; a value the file gives is kept.
+TEST(SurfaceTension, WcsphsArtificialViscosityIsSmallerIn3DWithSurfaceTension) {
+  const auto alpha = [](int dim, const std::string& method, const std::vector<std::string>& extra) {
+    return dropScene(dim, method, 0.005, extra).solver.artificial_viscosity;
+  };
+  EXPECT_EQ(alpha(3, "wcsph", {}), 0.01);
+  EXPECT_EQ(alpha(2, "wcsph", {}), 0.05);
+  EXPECT_EQ(alpha(3, "wcsph", {"fluids[0].surface_tension=0"}), 0.05);
+  EXPECT_EQ(alpha(3, "wcsph", {"solver.artificial_viscosity=0.05"}), 0.05);
+  EXPECT_EQ(alpha(3, "wcsph", {"solver.artificial_viscosity=0"}), 0);
+  EXPECT_EQ(alpha(3, "dfsph", {}), 0.05);
+  EXPECT_EQ(alpha(3, "pbf", {}), 0.05);
+}
+
 // 2D at the default support, which a 2D scene with surface tension gives 4 spacings in DFSPH and WCSPH
 // (FluidMethod::surfaceTensionSupport2d). Measured: DFSPH 0.968 and 1.000; WCSPH 1.001 and 0.988 (larger WCSPH drops
 // ring 8 to 16% fast, as its 3D drop does). At 2 spacings the lattice holds as a crystal and the drop does not ring
@@ -564,7 +585,7 @@ TEST(SurfaceTension, SurgeSimSaysTheAdhesionIsCalibratedAtTwoAndTwoAndAHalfSpaci
 }
 
 // The adhesion's calibration meets Young's angle in DFSPH only (ADropOnAPlateSettlesAtYoungsAngle; at the 3D
-// default support PBF reads 116, 96, 76 and WCSPH 125, 109, 91 degrees at 0.25, 0.5, 0.75): surge sim says so for a
+// default support PBF reads 116, 96, 76 and WCSPH 126, 111, 94 degrees at 0.25, 0.5, 0.75): surge sim says so for a
 // scene with adhesion in the others, with that method's figures.
 TEST(SurfaceTension, SurgeSimSaysTheAdhesionIsCalibratedInDfsph) {
   auto methodNotes = [](const std::string& method, const std::vector<std::string>& extra) {
@@ -583,7 +604,7 @@ TEST(SurfaceTension, SurgeSimSaysTheAdhesionIsCalibratedInDfsph) {
   EXPECT_NE(pbf[0].find("in PBF the same drop reads 116, 96, 76 degrees"), std::string::npos) << pbf[0];
   const auto wcsph = methodNotes("wcsph", {"colliders[0].adhesion=0.5"});
   ASSERT_EQ(wcsph.size(), 1u);
-  EXPECT_NE(wcsph[0].find("in WCSPH the same drop reads 125, 109, 91 degrees"), std::string::npos) << wcsph[0];
+  EXPECT_NE(wcsph[0].find("in WCSPH the same drop reads 126, 111, 94 degrees"), std::string::npos) << wcsph[0];
   EXPECT_TRUE(methodNotes("dfsph", {"colliders[0].adhesion=0.5"}).empty());
   EXPECT_TRUE(methodNotes("pbf", {}).empty());
   EXPECT_TRUE(methodNotes("pbf", {"colliders[0].adhesion=0.5", "fluids[0].surface_tension=0"}).empty());
