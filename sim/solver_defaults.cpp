@@ -245,8 +245,8 @@ std::vector<std::string> solverNotes(const Scene& scene) {
   if (adhesion && scene.dimensions == 2 && method.adhesionAngles2d) {
     const std::string elsewhere =
         std::abs(support - own) > 0.05 ? "; at this scene's " + threeFigures(support) + " it is not measured" : "";
-    notes.push_back("adhesion in 2D: a drop on a plate in " + name + " at its own " + threeFigures(own) +
-                    " spacings of kernel support reads " + method.adhesionAngles2d +
+    notes.push_back("adhesion in 2D: a 12 mm square of water on a plate in " + name + " at its own " +
+                    threeFigures(own) + " spacings of kernel support reads " + method.adhesionAngles2d +
                     " degrees at adhesion 0.25, 0.5, 0.75, where Young's angle is 120, 90, 60" + elsewhere +
                     " (docs/surface-tension.md)");
   }

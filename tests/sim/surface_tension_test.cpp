@@ -468,6 +468,21 @@ TEST(SurfaceTension, AnOilRectangleInWaterRoundsInEveryMethod) {
   EXPECT_EQ(lastFrame(runScene(scene, "oil_resumed", 1, true)), two);
 }
 
+// The contact angle of a drop on a plate at y = 0, in degrees, as a spherical (circular in 2D) cap's: 2 atan(h / r)
+// from its height h and its first layer's reach r from its centre along the plate, each to half a spacing; NaN
+// where no particle touches the plate.
+double capAngle(const ParticleFrame& drop) {
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();
+  for (const auto& p : drop.position) centre += p;
+  centre /= float(drop.size());
+  float height = 0, reach = 0;
+  for (const auto& p : drop.position) {
+    height = std::max(height, p.y() + 0.0005f);
+    if (p.y() < 0.001f) reach = std::max(reach, std::hypot(p.x() - centre.x(), p.z() - centre.z()) + 0.0005f);
+  }
+  return reach > 0 ? 2 * std::atan2(height, reach) * 180 / M_PI : NAN;
+}
+
 // Adhesion a = W_adhesion / (2 sigma) (sim/surface_tension.h): a cube of water (12^3 particles) set on a plate in
 // zero gravity settles to Young's angle, cos theta = 2a - 1, read from the spherical cap's height h and contact
 // radius r as theta = 2 atan(h / r). Half a spacing on each of h and r (about 9 spacings) moves that angle by up
@@ -485,19 +500,35 @@ TEST(SurfaceTension, ADropOnAPlateSettlesAtYoungsAngle) {
           "plate.json",
           {"fluids[0].surface_tension=" + std::to_string(kSigma), "colliders[0].adhesion=" + std::to_string(adhesion),
            std::string("solver.kernel_radius=") + support});
-      const ParticleFrame drop = readParticlePly(framePath(runScene(scene, "plate"), "particles", 30, "ply"));
-      Eigen::Vector3f centre = Eigen::Vector3f::Zero();
-      for (const auto& p : drop.position) centre += p;
-      centre /= float(drop.size());
-      float height = 0, radius = 0;
-      for (const auto& p : drop.position) {
-        height = std::max(height, p.y() + 0.0005f);
-        if (p.y() < 0.001f) radius = std::max(radius, std::hypot(p.x() - centre.x(), p.z() - centre.z()) + 0.0005f);
-      }
-      ASSERT_GT(radius, 0) << "the drop left the plate";
-      const double angle = 2 * std::atan2(height, radius) * 180 / M_PI;
+      const double angle = capAngle(readParticlePly(framePath(runScene(scene, "plate"), "particles", 30, "ply")));
+      ASSERT_FALSE(std::isnan(angle)) << "the drop left the plate";
       EXPECT_NEAR(angle, std::acos(2 * adhesion - 1) * 180 / M_PI, 10);
     }
+}
+
+// In 2D at DFSPH's default support (4 spacings) beta from Young's work of adhesion, whole, gives Young's angle for
+// a drop that settles: a 20 x 20 mm square, viscous (nu = 2e-4 m^2/s) so that its contact line creeps to its angle
+// rather than overshooting it, read at 3 s from its height and the half-width of its first layer, each to half a
+// spacing (a few degrees), within the 3D test's 10 degrees. Measured 119.7, 89.9, 64.5 (settled from 2 s: 120.3,
+// 89.8, 64.1 at 5 s). A 12 mm water drop's inertia carries its contact line past 60 degrees at 0.75 and it pins
+// there as a film (19 degrees; surge sim's 2D note); with 3D's share of beta at 2.5 spacings (0.75) the viscous
+// drop reads 133, 108, 84 and the test fails (docs/surface-tension.md, "Adhesion in 2D").
+TEST(SurfaceTension, A2DDropOnAPlateSettlesAtYoungsAngleInDfsph) {
+  for (double adhesion : {0.25, 0.5, 0.75}) {
+    SCOPED_TRACE("adhesion " + std::to_string(adhesion));
+    const Scene scene = parseScene(
+        R"({"name": "plate", "dimensions": 2, "domain": {"min": [-0.05, -0.006], "max": [0.05, 0.04]},
+          "particle_spacing": 0.001, "gravity": [0, 0], "solver": {"method": "dfsph"},
+          "fluids": [{"box": {"min": [-0.01, 0], "max": [0.01, 0.02]}, "viscosity": 2e-4}],
+          "colliders": [{"shape": "box", "position": [0, -0.003], "size": [0.1, 0.006]}],
+          "output": {"fps": 30, "frames": 90}})",
+        "plate2d.json",
+        {"fluids[0].surface_tension=" + std::to_string(kSigma), "colliders[0].adhesion=" + std::to_string(adhesion)});
+    const double angle = capAngle(readParticlePly(framePath(runScene(scene, "plate2d"), "particles", 90, "ply")));
+    ASSERT_FALSE(std::isnan(angle)) << "the drop left the plate";
+    std::printf("2D drop on a plate, adhesion %.2f: %.1f degrees\n", adhesion, angle);
+    EXPECT_NEAR(angle, std::acos(2 * adhesion - 1) * 180 / M_PI, 10);
+  }
 }
 
 // solver.kernel_radius 0 gives a scene with surface tension 2.5 spacings in 3D and the method's own support in 2D
