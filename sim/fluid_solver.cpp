@@ -1,5 +1,7 @@
 #include "sim/fluid_solver.h"
 
+#include <algorithm>
+
 #include "core/errors.h"
 #include "sim/dfsph_solver.h"
 #include "sim/pbf_solver.h"
@@ -47,6 +49,16 @@ void registerFluidMethod(const FluidMethod& method) {
       throw std::logic_error(std::string("registerFluidMethod: \"") + method.name + "\" is registered already");
   registry().push_back(method);
   solverMethodCatalog().push_back(catalogEntry(method));
+}
+
+void unregisterFluidMethod(const std::string& name) {
+  auto& methods = registry();
+  methods.erase(std::remove_if(methods.begin(), methods.end(), [&](const FluidMethod& m) { return name == m.name; }),
+                methods.end());
+  auto& catalog = solverMethodCatalog();
+  catalog.erase(std::remove_if(catalog.begin(), catalog.end(),
+                               [&](const SolverMethodEntry& entry) { return entry.name == name; }),
+                catalog.end());
 }
 
 template <int Dim>

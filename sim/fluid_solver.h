@@ -163,6 +163,9 @@ std::unique_ptr<FluidSolver<Dim>> makeMethod(const Scene& scene, std::shared_ptr
 const FluidMethod& fluidMethod(const std::string& name, const std::string& source = "scene");
 // Adds a method to the registry (a method outside the library: a test's, a plug-in's).
 void registerFluidMethod(const FluidMethod& method);
+// Takes a method registerFluidMethod added out of the registry again (a test's, so that the next test in the same
+// process sees the built-in methods' key table); nothing if it is not there.
+void unregisterFluidMethod(const std::string& name);
 
 // The solver of scene.solver.method. `shapes`: the scene's collider shapes, built once by the caller (null
 // builds them). InputError if the method is not registered.

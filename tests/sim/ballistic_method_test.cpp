@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "core/errors.h"
 #include "core/files.h"
 #include "core/ply.h"
 #include "core/progress.h"
@@ -14,8 +15,13 @@ namespace {
 
 // Registered, a fourth method is a choice of solver.method and `surge sim`'s frame loop runs it: a 2D block high
 // in its tank falls as symplectic Euler says, every particle by g dt^2 n (n + 1) / 2 after n steps of dt.
+// It leaves the registry as it found it: other tests in the same process compare the built-in methods' key table
+// with docs/scene-format.md (SolverDefaults.DocumentationListsEveryKey).
 TEST(BallisticMethod, ANewMethodIsAPairOfFilesAndOneRegistration) {
   registerFluidMethod(kBallisticMethod);
+  struct Unregister {
+    ~Unregister() { unregisterFluidMethod(kBallisticMethod.name); }
+  } unregister;
   const Scene scene = parseScene(
       R"({"name": "fall", "dimensions": 2, "domain": {"min": [0, 0], "max": [1, 2]}, "particle_spacing": 0.05,
           "fluids": [{"box": {"min": [0.2, 1.5], "max": [0.5, 1.8]}}],
@@ -36,6 +42,17 @@ TEST(BallisticMethod, ANewMethodIsAPairOfFilesAndOneRegistration) {
   for (size_t i = 0; i < last.size(); ++i) EXPECT_NEAR(startY[last.id[i]] - last.position[i].y(), fall, 2e-5);
   const std::string stats = readTextFile(dir / "stats.csv");
   EXPECT_EQ(std::count(stats.begin(), stats.end(), '\n'), 8);  // the header and frames 0 to 6
+}
+
+// Unregistered, the method is gone again: solver.method no longer offers it and the key table is the built-in
+// methods' (which docs/scene-format.md embeds).
+TEST(BallisticMethod, UnregisteringLeavesTheBuiltInMethods) {
+  const std::string builtIn = sceneKeysMarkdown();
+  registerFluidMethod(kBallisticMethod);
+  EXPECT_NE(sceneKeysMarkdown(), builtIn);
+  unregisterFluidMethod(kBallisticMethod.name);
+  EXPECT_EQ(sceneKeysMarkdown(), builtIn);
+  EXPECT_THROW(fluidMethod("ballistic"), InputError);
 }
 
 }  // namespace
