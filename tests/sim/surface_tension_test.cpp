@@ -575,6 +575,23 @@ TEST(SurfaceTension, SurgeSimSaysA2DDropAtTwoSpacingsKeepsItsShape) {
   EXPECT_EQ(crystalNotes(2, "pbf", {"solver.kernel_radius=0.0025"}), 0);
 }
 
+// PBF's 2D drop rings about 1.6 times as fast as Rayleigh's (docs/surface-tension.md): surge sim says so for a 2D
+// PBF scene with surface tension, and for no other.
+TEST(SurfaceTension, SurgeSimSaysPbfs2DDropRingsFast) {
+  auto fastNotes = [](int dim, const std::string& method, const std::vector<std::string>& extra) {
+    int count = 0;
+    for (const std::string& note : solverNotes(dropScene(dim, method, 0.005, extra)))
+      count += note.find("rings about 1.6 times as fast as Rayleigh's") != std::string::npos;
+    return count;
+  };
+  EXPECT_EQ(fastNotes(2, "pbf", {}), 1);
+  EXPECT_EQ(fastNotes(2, "pbf", {"solver.kernel_radius=0.003"}), 1);
+  EXPECT_EQ(fastNotes(2, "pbf", {"fluids[0].surface_tension=0"}), 0);
+  EXPECT_EQ(fastNotes(3, "pbf", {}), 0);
+  EXPECT_EQ(fastNotes(2, "dfsph", {}), 0);
+  EXPECT_EQ(fastNotes(2, "wcsph", {}), 0);
+}
+
 // In 3D the cohesion over 2 spacings holds a set (ABoxDropRoundsAndItsEnergyIsAccounted reads 2.3% there): surge
 // sim says so where a 3D scene with surface tension sets a support under the default's 2.5 spacings, and names it.
 TEST(SurfaceTension, SurgeSimSaysA3DDropAtTwoSpacingsKeepsASet) {
