@@ -231,7 +231,7 @@ std::vector<std::string> solverNotes(const Scene& scene) {
         " spacings it may not give Young's angle: measured, 2.25 wets more (113 and 76 degrees at 0.25 and "
         "0.5, a film at 0.75) and 3 less (118, 101, 84) (docs/surface-tension.md)");
   }
-  // It meets Young's angle in DFSPH; where a method's does not, its registration gives the angles it reads at
+  // It meets Young's angle in DFSPH and WCSPH; where a method's does not, its registration gives the angles it reads at
   // the 3D default support (FluidMethod::adhesionAngles).
   if (adhesion && scene.dimensions == 3 && method.adhesionAngles) {
     notes.push_back(

@@ -14,6 +14,7 @@ WcsphSolver<Dim>::WcsphSolver(const Scene& scene, std::shared_ptr<const Collider
     : Core(scene, std::move(shapes), sphRestLattice<Dim>(scene)),
       verlet_(scene.solver.integrator == "velocity_verlet"),
       tait_(scene.solver.equation_of_state == "tait"),
+      mirroredWalls_(!this->tension_.active()),
       kernel_(sphKernel<Dim>(scene)) {
   const SolverSettings& s = scene.solver;
   support_ = static_cast<float>(s.kernel_radius);
@@ -227,13 +228,19 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
         }
       }
       // The walls as mirrored particles with this particle's pressure continued hydrostatically, as the
-      // colliders' below (TankWalls::hydrostaticSum).
+      // colliders' below (TankWalls::hydrostaticSum). With surface tension the particle's own pressure once
+      // (Akinci 2012): the cohesion holds particles at a wall with its own pressure, where the mirrored wall's
+      // second share stands them off it and feeds their motion (docs/surface-tension.md, "WCSPH's walls").
       float unusedWeight = 0;
       VecD wallGradient = VecD::Zero();
       walls_.add(x_[i], unusedWeight, wallGradient);
       // The walls' pressure continued at the particle's own density, m_i / m_0 times density_.
       const float hydrostaticScale = (several ? massRatio[i] : 1.0f) / density_[i];
-      pressureForce -= 2.0f * pressureTermI * wallGradient + hydrostaticScale * walls_.hydrostaticSum(x_[i], gravity_);
+      if (mirroredWalls_)
+        pressureForce -=
+            2.0f * pressureTermI * wallGradient + hydrostaticScale * walls_.hydrostaticSum(x_[i], gravity_);
+      else
+        pressureForce -= pressureTermI * wallGradient;
       // The colliders likewise, their pressure continued hydrostatically (Colliders::hydrostaticSum); each
       // one's share is a force on the particle, recorded for colliders.csv.
       if (!colliders_.empty())
@@ -241,8 +248,10 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
           float unused;
           VecD gradient;
           colliders_.wallTerms(c, x_[i], d, n, unused, gradient);
-          const VecD force = -2.0f * pressureTermI * gradient -
-                             hydrostaticScale * colliders_.hydrostaticSum(c, x_[i], d, n, gravity_);
+          const VecD force = mirroredWalls_
+                                 ? VecD(-2.0f * pressureTermI * gradient -
+                                        hydrostaticScale * colliders_.hydrostaticSum(c, x_[i], d, n, gravity_))
+                                 : VecD(-pressureTermI * gradient);
           pressureForce += force;
           colliders_.addImpulse(i, c, (mass_ * mass_) * force, x_[i]);
         });

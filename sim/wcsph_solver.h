@@ -80,6 +80,9 @@ class WcsphSolver final : public ParticleSolver<Dim> {
 
   // Parameters.
   bool verlet_, tait_;
+  // The walls' and colliders' pressure: Adami's (the particle's mirrored and continued hydrostatically), or with
+  // surface tension Akinci 2012's (the particle's own once, the gradient of its compression energy).
+  bool mirroredWalls_;
   SphKernel<Dim> kernel_;
   float support_, smoothingLength_, speedOfSound_, gasConstant_, taitB_;
   float alpha_, nu_, nearStiffness_, cfl_, fixedStep_, backgroundPressure_;

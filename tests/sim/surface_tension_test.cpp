@@ -506,6 +506,20 @@ TEST(SurfaceTension, ADropOnAPlateSettlesAtYoungsAngle) {
     }
 }
 
+// A 20 x 20 mm square on a plate in zero gravity, in 2D at the method's default support, run for 3 s.
+fs::path squareOnAPlate(const std::string& method, double adhesion, const std::string& viscosity) {
+  const Scene scene = parseScene(
+      R"({"name": "plate", "dimensions": 2, "domain": {"min": [-0.05, -0.006], "max": [0.05, 0.04]},
+        "particle_spacing": 0.001, "gravity": [0, 0],
+        "fluids": [{"box": {"min": [-0.01, 0], "max": [0.01, 0.02]}}],
+        "colliders": [{"shape": "box", "position": [0, -0.003], "size": [0.1, 0.006]}],
+        "output": {"fps": 30, "frames": 90}})",
+      "plate2d.json",
+      {"solver.method=" + method, "fluids[0].viscosity=" + viscosity,
+       "fluids[0].surface_tension=" + std::to_string(kSigma), "colliders[0].adhesion=" + std::to_string(adhesion)});
+  return runScene(scene, "plate2d_" + method);
+}
+
 // In 2D at DFSPH's default support (4 spacings) beta from Young's work of adhesion, whole, gives Young's angle for
 // a drop that settles: a 20 x 20 mm square, viscous (nu = 2e-4 m^2/s) so that its contact line creeps to its angle
 // rather than overshooting it, read at 3 s from its height and the half-width of its first layer, each to half a
@@ -516,18 +530,32 @@ TEST(SurfaceTension, ADropOnAPlateSettlesAtYoungsAngle) {
 TEST(SurfaceTension, A2DDropOnAPlateSettlesAtYoungsAngleInDfsph) {
   for (double adhesion : {0.25, 0.5, 0.75}) {
     SCOPED_TRACE("adhesion " + std::to_string(adhesion));
-    const Scene scene = parseScene(
-        R"({"name": "plate", "dimensions": 2, "domain": {"min": [-0.05, -0.006], "max": [0.05, 0.04]},
-          "particle_spacing": 0.001, "gravity": [0, 0], "solver": {"method": "dfsph"},
-          "fluids": [{"box": {"min": [-0.01, 0], "max": [0.01, 0.02]}, "viscosity": 2e-4}],
-          "colliders": [{"shape": "box", "position": [0, -0.003], "size": [0.1, 0.006]}],
-          "output": {"fps": 30, "frames": 90}})",
-        "plate2d.json",
-        {"fluids[0].surface_tension=" + std::to_string(kSigma), "colliders[0].adhesion=" + std::to_string(adhesion)});
-    const double angle = capAngle(readParticlePly(framePath(runScene(scene, "plate2d"), "particles", 90, "ply")));
+    const double angle =
+        capAngle(readParticlePly(framePath(squareOnAPlate("dfsph", adhesion, "2e-4"), "particles", 90, "ply")));
     ASSERT_FALSE(std::isnan(angle)) << "the drop left the plate";
     std::printf("2D drop on a plate, adhesion %.2f: %.1f degrees\n", adhesion, angle);
     EXPECT_NEAR(angle, std::acos(2 * adhesion - 1) * 180 / M_PI, 10);
+  }
+}
+
+// WCSPH's walls take a particle's pressure once in a scene with surface tension (Akinci 2012), not mirrored: the
+// cohesion holds the contact layer at the plate with its own pressure, where the mirrored wall's second share
+// stood it off the plate (the adhesion's calibration assumes the rest lattice's stand-off) and fed its motion. The
+// water square at 3 s: within the DFSPH test's 10 degrees of Young's (measured 124.8, 90.3, 55.5), and at rest, its
+// motion under 1% of the surface energy released (measured 1e-4, 4e-6, 4e-6 of it). Mirrored, it stirred at 8 to
+// 100% of it, read 111 and 98 degrees at 0.5 and 0.75, and at 0.25 the energy check stopped it at frame 82.
+TEST(SurfaceTension, A2DWaterDropOnAPlateSettlesAtYoungsAngleInWcsph) {
+  for (double adhesion : {0.25, 0.5, 0.75}) {
+    SCOPED_TRACE("adhesion " + std::to_string(adhesion));
+    const fs::path dir = squareOnAPlate("wcsph", adhesion, "0");
+    const double angle = capAngle(readParticlePly(framePath(dir, "particles", 90, "ply")));
+    ASSERT_FALSE(std::isnan(angle)) << "the drop left the plate";
+    const auto stats = readStats(dir);
+    const double motion = stats.at("kinetic_energy").back(), released = stats.at("source_work").back();
+    std::printf("WCSPH 2D water drop on a plate, adhesion %.2f: %.1f degrees, motion %.2g of the %.3g J/m released\n",
+                adhesion, angle, motion / released, released);
+    EXPECT_NEAR(angle, std::acos(2 * adhesion - 1) * 180 / M_PI, 10);
+    EXPECT_LT(motion, 0.01 * released);
   }
 }
 
@@ -632,9 +660,10 @@ TEST(SurfaceTension, SurgeSimSaysTheAdhesionIsCalibratedAtTwoAndTwoAndAHalfSpaci
   EXPECT_EQ(adhesionNotes({"solver.kernel_radius=0.0025"}), 0);
 }
 
-// The adhesion's calibration meets Young's angle in DFSPH only (ADropOnAPlateSettlesAtYoungsAngle; at the 3D
-// default support PBF reads 116, 96, 76 and WCSPH 126, 111, 94 degrees at 0.25, 0.5, 0.75): surge sim says so for a
-// scene with adhesion in the others, with that method's figures.
+// The adhesion's calibration meets Young's angle in DFSPH (ADropOnAPlateSettlesAtYoungsAngle) and in WCSPH (117, 92,
+// 69 degrees at 0.25, 0.5, 0.75 since its walls take the particle's pressure once with surface tension; before,
+// 126, 111, 94); PBF reads 116, 96, 76 at the 3D default support: surge sim says so for a scene with adhesion in
+// PBF, with its figures.
 TEST(SurfaceTension, SurgeSimSaysTheAdhesionIsCalibratedInDfsph) {
   auto methodNotes = [](const std::string& method, const std::vector<std::string>& extra) {
     std::string json = R"({"name": "plate", "dimensions": 3, "domain": {"min": [-0.02, -0.006, -0.02],
@@ -650,16 +679,14 @@ TEST(SurfaceTension, SurgeSimSaysTheAdhesionIsCalibratedInDfsph) {
   const auto pbf = methodNotes("pbf", {"colliders[0].adhesion=0.5"});
   ASSERT_EQ(pbf.size(), 1u);
   EXPECT_NE(pbf[0].find("in PBF the same drop reads 116, 96, 76 degrees"), std::string::npos) << pbf[0];
-  const auto wcsph = methodNotes("wcsph", {"colliders[0].adhesion=0.5"});
-  ASSERT_EQ(wcsph.size(), 1u);
-  EXPECT_NE(wcsph[0].find("in WCSPH the same drop reads 126, 111, 94 degrees"), std::string::npos) << wcsph[0];
+  EXPECT_TRUE(methodNotes("wcsph", {"colliders[0].adhesion=0.5"}).empty());
   EXPECT_TRUE(methodNotes("dfsph", {"colliders[0].adhesion=0.5"}).empty());
   EXPECT_TRUE(methodNotes("pbf", {}).empty());
   EXPECT_TRUE(methodNotes("pbf", {"colliders[0].adhesion=0.5", "fluids[0].surface_tension=0"}).empty());
 }
 
 // In 2D surge sim gives each method's own angles (FluidMethod::adhesionAngles2d, the 3D test's drop in 2D at the
-// method's 2D support: DFSPH 124, 92, 19; PBF 121, 90, 73; WCSPH 131, 114, 98 degrees) in place of the 3D notes,
+// method's 2D support: DFSPH 124, 92, 19; PBF 121, 90, 73; WCSPH 122, 93, 44 degrees) in place of the 3D notes,
 // and says where the scene's support is not the one they were measured at.
 TEST(SurfaceTension, SurgeSimGivesEachMethodsAdhesionAnglesIn2D) {
   auto adhesionNotes = [](const std::string& method, const std::vector<std::string>& extra) {
@@ -675,7 +702,7 @@ TEST(SurfaceTension, SurgeSimGivesEachMethodsAdhesionAnglesIn2D) {
   const std::vector<std::pair<std::string, std::string>> angles = {
       {"dfsph", "DFSPH at its own 4 spacings of kernel support reads 124, 92, 19 degrees"},
       {"pbf", "PBF at its own 2.5 spacings of kernel support reads 121, 90, 73 degrees"},
-      {"wcsph", "WCSPH at its own 4 spacings of kernel support reads 131, 114, 98 degrees"}};
+      {"wcsph", "WCSPH at its own 4 spacings of kernel support reads 122, 93, 44 degrees"}};
   for (const auto& [method, text] : angles) {
     const auto own = adhesionNotes(method, {"colliders[0].adhesion=0.5"});
     ASSERT_EQ(own.size(), 1u) << method;
