@@ -230,7 +230,8 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
       // The walls as mirrored particles with this particle's pressure continued hydrostatically, as the
       // colliders' below (TankWalls::hydrostaticSum). With surface tension the particle's own pressure once
       // (Akinci 2012): the cohesion holds particles at a wall with its own pressure, where the mirrored wall's
-      // second share stands them off it and feeds their motion (docs/surface-tension.md, "WCSPH's walls").
+      // second share stands them off it and feeds their motion (docs/surface-tension.md, "WCSPH's walls with surface
+      // tension").
       float unusedWeight = 0;
       VecD wallGradient = VecD::Zero();
       walls_.add(x_[i], unusedWeight, wallGradient);
