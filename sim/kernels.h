@@ -1,7 +1,7 @@
 // SPH smoothing kernels, templated on the dimension; the 2D normalisations make each integrate to one over the
 // plane. Kernels: poly6 and spiky (Mueller et al. 2003), as Position Based Fluids uses them (PBF eq. 2 and 8).
 // CubicSplineKernel and WendlandC2Kernel: the SPH methods' (WCSPH, DFSPH), chosen by `solver.kernel` through
-// SphKernel, the one place that reads that key.
+// SphKernel, the one place that reads that key. PbfWendlandC2: Wendland C2 in the interface of PBF's Kernels.
 #pragma once
 
 #include <Eigen/Core>
@@ -41,6 +41,8 @@ class Kernels {
     const float d = std::max(h2_ - r2, 0.0f);  // branch-free, for the vectorised loops
     return poly6_ * d * d * d;
   }
+
+  float weight(float r2) const { return poly6(r2); }  // the names PbfWendlandC2 shares: W of eq. 2, from r^2
 
   // W_spiky(r, h); used only to test normalisation, PBF needs only its gradient.
   float spiky(float r) const {
@@ -154,6 +156,27 @@ class WendlandC2Kernel {
 
  private:
   float support_, inverseSupport_, sigma_;
+};
+
+// Wendland C2 in the interface of PBF's Kernels: weight and pair from r^2, gradient from r. PBF takes it for both
+// its density (eq. 2) and its constraint's gradient (eq. 8) in a 2D scene with surface tension, where poly6 and
+// spiky hold a drop's lattice as a stiff body (PbfSolver::wendland_; docs/surface-tension.md, "PBF's 2D kernel").
+template <int Dim>
+class PbfWendlandC2 {
+ public:
+  explicit PbfWendlandC2(float h) : inverseSupport_(1.0f / h), sigma_(WendlandC2Kernel<Dim>(h).value(0.0f)) {}
+  float weight(float r2) const { return pair(r2).weight; }
+  // Branch-free for the vectorised loops: with q = r / h and d = 1 - q, W = sigma d^4 (1 + 4 q) and
+  // grad W = -20 sigma d^3 / h^2 r (WendlandC2Kernel's gradient factor with q / r = 1 / h).
+  typename Kernels<Dim>::Pair pair(float r2) const {
+    const float q = std::sqrt(r2) * inverseSupport_;
+    const float d = std::max(1.0f - q, 0.0f), d3 = d * d * d;
+    return {sigma_ * d3 * d * (1.0f + 4.0f * q), -20.0f * sigma_ * inverseSupport_ * inverseSupport_ * d3};
+  }
+  Vec<Dim> gradient(const Vec<Dim>& r, float rLength) const { return pair(rLength * rLength).gradientFactor * r; }
+
+ private:
+  float inverseSupport_, sigma_;
 };
 
 // The scene's SPH kernel (`solver.kernel`, support `solver.kernel_radius`): visit(use) calls use(kernel) with

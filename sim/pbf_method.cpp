@@ -97,14 +97,6 @@ std::vector<std::string> pbfNotes(const Scene& scene) {
     notes.push_back("solver.scorr_k where the fluids' densities differ: s_corr's push, a step's, holds the interior "
                     "against the flow (a Rayleigh-Taylor mode grows at 0.60 of theory at 32 steps a frame); left out, "
                     "it is 0 in such a scene");
-  // PBF's 2D drop answers its cohesion as a stiffer body (docs/surface-tension.md, "PBF's 2D drop by kick and
-  // radius"): a researcher timing capillary waves should know before the run.
-  if (scene.dimensions == 2 && sceneSurfaceTension(scene) > 0)
-    notes.push_back(
-        "surface tension in 2D PBF: a drop's l = 2 oscillation rings about 1.6 times as fast as "
-        "Rayleigh's (back through its rest shape at 0.55 to 0.61 of his half period, 20 particles across, "
-        "at the default support) and damps within a few periods; DFSPH's and WCSPH's ring at his within "
-        "4% (docs/surface-tension.md)");
   // PBF's push keeps a flow's particles even (a Taylor-Green vortex within 2.3%), but stirs a fluid at rest.
   if (scene.solver.background_pressure > 0)
     notes.push_back("solver.background_pressure in PBF keeps a flow's particles even but stirs a fluid at rest: a "
@@ -122,6 +114,6 @@ const FluidMethod kPbfMethod = {"pbf", "Position Based Fluids (Macklin & Mueller
     &makeMethod<PbfSolver, 2>, &makeMethod<PbfSolver, 3>, 250, 400,
     &pbfPushesPerFrame, &resolvePbfDefaults, &pbfNotes, &declarePbfKeys,
     "more solver.substeps or solver.iterations (at many steps a frame, a smaller solver.scorr_k: its push is a step's)",
-    true, "solver.iterations", "116, 96, 76", 2.5, "121, 90, 73"};
+    true, "solver.iterations", "116, 96, 76", 2.5, "117, 90, 62"};
 
 }  // namespace surge

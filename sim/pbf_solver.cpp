@@ -26,10 +26,22 @@ inline float integerPower(float x, int n) {
 // may differ in the last bits), never on the thread count. A pair closer than coincidentLength_ (see
 // coincidentOffset) is rare; its particle is done again by the scalar loop beside.
 
-// The rest lattice through poly6 (eq. 2) and the spiky gradient (eq. 8).
+// Wendland C2 for eq. 2 and 8 in a 2D scene with surface tension (PbfWendlandC2); poly6 and spiky elsewhere.
+bool pbfUsesWendland(const Scene& scene) {
+  return scene.dimensions == 2 && sceneSurfaceTension(scene) > 0;
+}
+
+// The rest lattice through the density's kernel (eq. 2) and its gradient's (eq. 8).
 template <int Dim>
 RestLattice<Dim> pbfRestLattice(const Scene& scene) {
-  const Kernels<Dim> kernels(static_cast<float>(scene.solver.kernel_radius));
+  const float h = static_cast<float>(scene.solver.kernel_radius);
+  if (pbfUsesWendland(scene)) {
+    const PbfWendlandC2<Dim> kernels(h);
+    return RestLattice<Dim>(
+        scene, h, [&](const Vec<Dim>& r) { return kernels.weight(r.squaredNorm()); },
+        [&](const Vec<Dim>& r) { return kernels.gradient(r, r.norm()); });
+  }
+  const Kernels<Dim> kernels(h);
   return RestLattice<Dim>(
       scene, kernels.radius(), [&](const Vec<Dim>& r) { return kernels.poly6(r.squaredNorm()); },
       [&](const Vec<Dim>& r) { return kernels.spikyGradient(r, r.norm()); });
@@ -44,9 +56,11 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
     : PbfSolver(scene, std::move(shapes), pbfRestLattice<Dim>(scene)) {}
 
 template <int Dim>
-PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes,
-                          RestLattice<Dim> lattice)
-    : Core(scene, std::move(shapes), lattice), kernels_(static_cast<float>(scene.solver.kernel_radius)) {
+PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, RestLattice<Dim> lattice)
+    : Core(scene, std::move(shapes), lattice),
+      kernels_(static_cast<float>(scene.solver.kernel_radius)),
+      wendlandKernels_(static_cast<float>(scene.solver.kernel_radius)),
+      wendland_(pbfUsesWendland(scene)) {
   substeps_ = scene.solver.substeps;
   const SolverSettings& s = scene.solver;
   const float spacing = static_cast<float>(scene.particle_spacing);
@@ -61,8 +75,14 @@ PbfSolver<Dim>::PbfSolver(const Scene& scene, std::shared_ptr<const ColliderShap
   scorrK_ = this->periodic_.everyAxis() ? 0.0f : static_cast<float>(s.scorr_k);
   scorrN_ = s.scorr_n;
   const float dq = static_cast<float>(s.scorr_delta_q * s.kernel_radius);
-  scorrInvWdq_ = 1.0f / kernels_.poly6(dq * dq);
-  scorrAtRest_ = integerPower(kernels_.poly6(spacing * spacing) * scorrInvWdq_, scorrN_);
+  const auto scorrScales = [&](const auto& kernels) {  // each kernel's own expression (kernelWeight rounds r^2 first)
+    scorrInvWdq_ = 1.0f / kernels.weight(dq * dq);
+    scorrAtRest_ = integerPower(kernels.weight(spacing * spacing) * scorrInvWdq_, scorrN_);
+  };
+  if (wendland_)
+    scorrScales(wendlandKernels_);
+  else
+    scorrScales(kernels_);
   vorticityEpsilon_ = static_cast<float>(s.vorticity_epsilon);
   xsphC_ = static_cast<float>(s.xsph_c);
   warmStart_ = static_cast<float>(s.warm_start);
@@ -205,15 +225,23 @@ void PbfSolver<Dim>::applyWarmStart() {
 // above it (hydrostatic pressure) and a light fluid under a heavy one is pushed up.
 template <int Dim>
 double PbfSolver<Dim>::computeLambdas(float omega) {
-  if (this->periodic_.active())
-    return massRatio_.empty() ? computeLambdasOf<false, true>(omega) : computeLambdasOf<true, true>(omega);
-  return massRatio_.empty() ? computeLambdasOf<false, false>(omega) : computeLambdasOf<true, false>(omega);
+  return wendland_ ? computeLambdasWith<true>(omega) : computeLambdasWith<false>(omega);
 }
 
 template <int Dim>
-template <bool kSeveral, bool kPeriodic>
+template <bool kWendland>
+double PbfSolver<Dim>::computeLambdasWith(float omega) {
+  if (this->periodic_.active())
+    return massRatio_.empty() ? computeLambdasOf<false, true, kWendland>(omega)
+                              : computeLambdasOf<true, true, kWendland>(omega);
+  return massRatio_.empty() ? computeLambdasOf<false, false, kWendland>(omega)
+                            : computeLambdasOf<true, false, kWendland>(omega);
+}
+
+template <int Dim>
+template <bool kSeveral, bool kPeriodic, bool kWendland>
 double PbfSolver<Dim>::computeLambdasOf(float omega) {
-  const float selfWeight = kernels_.poly6(0.0f);
+  const float selfWeight = kernelsOf<kWendland>().weight(0.0f);
   [[maybe_unused]] const float* inverse = inverseMassRatio_.data();  // w
   const double averageError = parallelSum<double>(0, size(), [&](size_t b, size_t e) {
     // A copy of the thread's own: its periods stay in registers through the vectorised loop (read through the
@@ -240,7 +268,7 @@ double PbfSolver<Dim>::computeLambdasOf(float omega) {
         if constexpr (kPeriodic) periodic.nearest(r0, r1, r2);
         const float length2 = r0 * r0 + r1 * r1 + r2 * r2;
         coincident |= length2 <= coincidentLength_ * coincidentLength_;
-        const auto pair = kernels_.pair(length2);
+        const auto pair = kernelsOf<kWendland>().pair(length2);
         factors[k] = pair.gradientFactor;
         w += pair.weight;
         g0 += pair.gradientFactor * r0;
@@ -259,7 +287,7 @@ double PbfSolver<Dim>::computeLambdasOf(float omega) {
         for (int k = 0; k < count; ++k) {
           const VecD r = pairOffset(i, neighbor[k], pi);
           const float r2 = r.squaredNorm();
-          const auto pair = kernels_.pair(r2);
+          const auto pair = kernelsOf<kWendland>().pair(r2);
           factors[k] = pair.gradientFactor;
           weight += pair.weight;
           gradientSum += pair.gradientFactor * r;
@@ -305,7 +333,7 @@ double PbfSolver<Dim>::computeLambdasOf(float omega) {
 //   rest spacing (unshifted, it swells a resting column) and acts only where lambda_i = lambda_j = 0, in spray
 //   and thin sheets (in compressed fluid it adds pressure that becomes kinetic energy).
 template <int Dim>
-template <bool kWarmStart, bool kPeriodic>
+template <bool kWarmStart, bool kPeriodic, bool kWendland>
 void PbfSolver<Dim>::applyPositionCorrectionsOf() {
   const bool scorr = scorrK_ > 0 && !kWarmStart;
   const bool sumLambdas = !kWarmStart && !lambdaTotal_.empty();
@@ -323,15 +351,17 @@ void PbfSolver<Dim>::applyPositionCorrectionsOf() {
       const uint32_t* neighbor = neighbors_.begin(i);
       const int count = static_cast<int>(neighbors_.end(i) - neighbor);
       // s_corr's coefficient for a pair at squared distance r2 (used where lambda_i + lambda_j = 0).
-      auto artificialPressure = [kernels = kernels_, scorrScale, inverse = scorrInvWdq_, n = scorrN_,
+      auto artificialPressure = [kernels = kernelsOf<kWendland>(), scorrScale, inverse = scorrInvWdq_, n = scorrN_,
                                  atRest = scorrAtRest_](float r2) {
-        const float excess = integerPower(kernels.poly6(r2) * inverse, n) - atRest;
+        const float excess = integerPower(kernels.weight(r2) * inverse, n) - atRest;
         return excess > 0.0f ? -scorrScale * excess : 0.0f;
       };
       // The pair's gradient factor: the lambda pass's, or evaluated here for the warm start.
       auto gradientFactor = [&](int k, float r2) {
-        if constexpr (kWarmStart) return kernels_.pair(r2).gradientFactor;
-        else return factors[k];
+        if constexpr (kWarmStart)
+          return kernelsOf<kWendland>().pair(r2).gradientFactor;
+        else
+          return factors[k];
       };
       // The vectorised loop (see the note at the top); a coincident pair sends the particle to the scalar loop after it.
       const float* p = p_.data()->data();
@@ -442,7 +472,7 @@ FluidMeasures PbfSolver<Dim>::measure() {
     p_ = x_;  // before the first step: neighbours of the current positions
     findNeighbors();
   }
-  return this->measureWith([&](float r2) { return kernels_.poly6(r2); });
+  return this->measureWith([&](float r2) { return kernelWeight(r2); });
 }
 
 template <int Dim>

@@ -78,19 +78,46 @@ class PbfSolver final : public ParticleSolver<Dim> {
   // Eq. 11 (with the Chebyshev weight omega of this iteration, 1 for plain Jacobi); returns the average density
   // error before this iteration's correction.
   double computeLambdas(float omega);
-  template <bool kSeveral, bool kPeriodic>
+  template <bool kWendland>
+  double computeLambdasWith(float omega);
+  template <bool kSeveral, bool kPeriodic, bool kWendland>
   double computeLambdasOf(float omega);
   void applyWarmStart();
   // Eq. 12 from lambda_: an iteration's correction, or with kWarmStart the warm start's (kernel gradients
   // evaluated here rather than read from the lambda pass, no s_corr, nothing added to the lambda totals).
   template <bool kWarmStart>
   void applyPositionCorrections() {
-    if (this->periodic_.active()) applyPositionCorrectionsOf<kWarmStart, true>();
-    else applyPositionCorrectionsOf<kWarmStart, false>();
+    if (wendland_)
+      applyPositionCorrectionsWith<kWarmStart, true>();
+    else
+      applyPositionCorrectionsWith<kWarmStart, false>();
+  }
+  template <bool kWarmStart, bool kWendland>
+  void applyPositionCorrectionsWith() {
+    if (this->periodic_.active())
+      applyPositionCorrectionsOf<kWarmStart, true, kWendland>();
+    else
+      applyPositionCorrectionsOf<kWarmStart, false, kWendland>();
   }
   // kPeriodic: pairs take their nearest image (sim/periodic.h); without it the loops are what they were.
-  template <bool kWarmStart, bool kPeriodic>
+  template <bool kWarmStart, bool kPeriodic, bool kWendland>
   void applyPositionCorrectionsOf();
+  // The kernels of eq. 2 and 8: poly6 and spiky, or with kWendland Wendland C2 for both (wendland_). The hot
+  // loops are compiled for each and pick one per pass; the passes that run seldom pick per pair (kernelWeight...).
+  template <bool kWendland>
+  const auto& kernelsOf() const {
+    if constexpr (kWendland)
+      return wendlandKernels_;
+    else
+      return kernels_;
+  }
+  float kernelWeight(float r2) const { return wendland_ ? wendlandKernels_.weight(r2) : kernels_.poly6(r2); }
+  typename Kernels<Dim>::Pair kernelPair(float r2) const {
+    return wendland_ ? wendlandKernels_.pair(r2) : kernels_.pair(r2);
+  }
+  VecD kernelGradient(const VecD& r, float length) const {
+    return wendland_ ? wendlandKernels_.gradient(r, length) : kernels_.spikyGradient(r, length);
+  }
   void pullBySurfaceTension(float dt);
   void updateVelocities(float dt);
   // p*_i += delta_i, stopped at the colliders and the tank (the position corrections, the push).
@@ -105,12 +132,16 @@ class PbfSolver final : public ParticleSolver<Dim> {
   void applyFriction();
   void applyVorticityConfinement(float dt);
   void applyXsphViscosity();
+  template <bool kWendland>
+  void applyXsphViscosityWith();
   // The offset p_i - p_j used for a pair closer than coincidentLength_ (see the .cpp).
   VecD coincidentOffset(size_t i, size_t j) const;
   VecD pairOffset(size_t i, size_t j, const VecD& pi) const;  // p_i - p_j, or the offset above
 
   // Parameters, fixed at construction.
-  Kernels<Dim> kernels_;
+  Kernels<Dim> kernels_;                // poly6 and spiky (eq. 2 and 8)
+  PbfWendlandC2<Dim> wendlandKernels_;  // in their place in a 2D scene with surface tension (pbfUsesWendland)
+  bool wendland_;
   float massOverRho_, epsilon_, latticeGradientSum_;
   float scorrK_, scorrInvWdq_, scorrAtRest_;
   int scorrN_;

@@ -12,13 +12,13 @@ template <int Dim>
 void PbfSolver<Dim>::prepareFilledDomain(float dt) {
   const PhaseTimer timer(times_.pressure);
   densityRatio_.resize(size());
-  const float selfWeight = kernels_.poly6(0.0f);
+  const float selfWeight = kernelWeight(0.0f);
   parallelFor(0, size(), [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const VecD pi = p_[i];
       float weight = selfWeight;
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j)
-        weight += kernels_.poly6(pairOffset(i, *j, pi).squaredNorm());
+        weight += kernelWeight(pairOffset(i, *j, pi).squaredNorm());
       VecD unused = VecD::Zero();
       walls_.add(pi, weight, unused);
       densityRatio_[i] = mass_ * weight / restDensity_;
@@ -45,7 +45,7 @@ void PbfSolver<Dim>::prepareFilledDomain(float dt) {
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
         const VecD r = pairOffset(i, *j, pi);
         const float inverseSquareJ = 1.0f / (densityRatio_[*j] * densityRatio_[*j]);
-        sum += ((inverseSquareI + inverseSquareJ) * kernels_.pair(r.squaredNorm()).gradientFactor) * r;
+        sum += ((inverseSquareI + inverseSquareJ) * kernelPair(r.squaredNorm()).gradientFactor) * r;
       }
       transportPush_[i] = (inverseMassRatio_.empty() ? scale : scale * inverseMassRatio_[i]) * sum;
     }

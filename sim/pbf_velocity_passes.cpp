@@ -25,7 +25,7 @@ void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
         VecD r = p_[i] - p_[*j];
         wrap(r);
-        const VecD gradientJ = -kernels_.spikyGradient(r, r.norm());  // grad with respect to p_j
+        const VecD gradientJ = -kernelGradient(r, r.norm());  // grad with respect to p_j
         Eigen::Vector3f vij = Eigen::Vector3f::Zero(), g = Eigen::Vector3f::Zero();
         vij.head<Dim>() = v_[*j] - v_[i];
         g.head<Dim>() = gradientJ;
@@ -43,7 +43,7 @@ void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
       for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
         VecD r = p_[i] - p_[*j];
         wrap(r);
-        eta += (omegaMagnitude(*j) - omegaMagnitude(i)) * kernels_.spikyGradient(r, r.norm());
+        eta += (omegaMagnitude(*j) - omegaMagnitude(i)) * kernelGradient(r, r.norm());
       }
       const float etaLength = eta.norm();
       if (etaLength < 1e-12f) continue;
@@ -62,6 +62,15 @@ void PbfSolver<Dim>::applyVorticityConfinement(float dt) {
 // (the particle volume) makes c dimensionless, as the paper's c = 0.01 assumes unit particle volume.
 template <int Dim>
 void PbfSolver<Dim>::applyXsphViscosity() {
+  if (wendland_)
+    applyXsphViscosityWith<true>();
+  else
+    applyXsphViscosityWith<false>();
+}
+
+template <int Dim>
+template <bool kWendland>
+void PbfSolver<Dim>::applyXsphViscosityWith() {
   const PhaseTimer timer(times_.forces);
   std::vector<VecD>& smoothed = vectorScratch_;
   smoothed.resize(size());
@@ -74,7 +83,7 @@ void PbfSolver<Dim>::applyXsphViscosity() {
         for (const uint32_t* j = neighbors_.begin(i); j != neighbors_.end(i); ++j) {
           VecD r = p_[i] - p_[*j];
           wrap(r);
-          sum += (v_[*j] - v_[i]) * kernels_.poly6(r.squaredNorm());
+          sum += (v_[*j] - v_[i]) * kernelsOf<kWendland>().weight(r.squaredNorm());
         }
         smoothed[i] = v_[i] + scale * sum;
       }
