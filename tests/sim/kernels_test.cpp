@@ -111,5 +111,32 @@ TEST(Kernels, CubicSplineAndWendlandAreNormalised) {
   expectKernelNormalisedWithMatchingGradient<2, WendlandC2Kernel<2>>(2.0f);
 }
 
+// PBF's Wendland C2 (PbfWendlandC2, its closed form from r^2) is the SPH methods' WendlandC2Kernel: the same W and
+// gradient factor within float rounding across the support, W(0) = sigma, and nothing at or beyond h.
+template <int Dim>
+void expectPbfWendlandIsWendland(float support) {
+  const PbfWendlandC2<Dim> pbf(support);
+  const WendlandC2Kernel<Dim> sph(support);
+  for (float q : {0.05f, 0.2f, 0.4f, 0.5f, 0.7f, 0.9f, 0.99f}) {
+    const float r = q * support;
+    const auto pair = pbf.pair(r * r);
+    EXPECT_NEAR(pair.weight, sph.value(r), 1e-5f * sph.value(0)) << "q = " << q;
+    EXPECT_NEAR(pair.gradientFactor, sph.gradientFactor(r), 1e-5f * std::abs(sph.gradientFactor(0.5f * support)))
+        << "q = " << q;
+    EXPECT_EQ(pbf.weight(r * r), pair.weight);
+    const Vec<Dim> offset = Vec<Dim>::Constant(r / std::sqrt(float(Dim)));
+    EXPECT_TRUE(pbf.gradient(offset, r).isApprox(pair.gradientFactor * offset));
+  }
+  EXPECT_FLOAT_EQ(pbf.weight(0.0f), sph.value(0.0f));
+  EXPECT_EQ(pbf.pair(support * support).weight, 0.0f);
+  EXPECT_EQ(pbf.pair(support * support).gradientFactor, 0.0f);
+  EXPECT_EQ(pbf.pair(4 * support * support).weight, 0.0f);
+}
+
+TEST(Kernels, PbfsWendlandIsTheSphMethodsWendland) {
+  expectPbfWendlandIsWendland<2>(0.0025f);
+  expectPbfWendlandIsWendland<3>(0.1f);
+}
+
 }  // namespace
 }  // namespace surge
