@@ -42,7 +42,9 @@ class Kernels {
     return poly6_ * d * d * d;
   }
 
-  float weight(float r2) const { return poly6(r2); }  // the names PbfWendlandC2 shares: W of eq. 2, from r^2
+  // The names PbfWendlandC2 shares: W of eq. 2 from r^2, and the gradient of eq. 8.
+  float weight(float r2) const { return poly6(r2); }
+  Vec<Dim> gradient(const Vec<Dim>& r, float rLength) const { return spikyGradient(r, rLength); }
 
   // W_spiky(r, h); used only to test normalisation, PBF needs only its gradient.
   float spiky(float r) const {

@@ -35,16 +35,12 @@ bool pbfUsesWendland(const Scene& scene) {
 template <int Dim>
 RestLattice<Dim> pbfRestLattice(const Scene& scene) {
   const float h = static_cast<float>(scene.solver.kernel_radius);
-  if (pbfUsesWendland(scene)) {
-    const PbfWendlandC2<Dim> kernels(h);
+  const auto latticeOf = [&](const auto& kernels) {
     return RestLattice<Dim>(
         scene, h, [&](const Vec<Dim>& r) { return kernels.weight(r.squaredNorm()); },
         [&](const Vec<Dim>& r) { return kernels.gradient(r, r.norm()); });
-  }
-  const Kernels<Dim> kernels(h);
-  return RestLattice<Dim>(
-      scene, kernels.radius(), [&](const Vec<Dim>& r) { return kernels.poly6(r.squaredNorm()); },
-      [&](const Vec<Dim>& r) { return kernels.spikyGradient(r, r.norm()); });
+  };
+  return pbfUsesWendland(scene) ? latticeOf(PbfWendlandC2<Dim>(h)) : latticeOf(Kernels<Dim>(h));
 }
 
 }  // namespace

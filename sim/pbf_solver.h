@@ -111,12 +111,12 @@ class PbfSolver final : public ParticleSolver<Dim> {
     else
       return kernels_;
   }
-  float kernelWeight(float r2) const { return wendland_ ? wendlandKernels_.weight(r2) : kernels_.poly6(r2); }
+  float kernelWeight(float r2) const { return wendland_ ? wendlandKernels_.weight(r2) : kernels_.weight(r2); }
   typename Kernels<Dim>::Pair kernelPair(float r2) const {
     return wendland_ ? wendlandKernels_.pair(r2) : kernels_.pair(r2);
   }
   VecD kernelGradient(const VecD& r, float length) const {
-    return wendland_ ? wendlandKernels_.gradient(r, length) : kernels_.spikyGradient(r, length);
+    return wendland_ ? wendlandKernels_.gradient(r, length) : kernels_.gradient(r, length);
   }
   void pullBySurfaceTension(float dt);
   void updateVelocities(float dt);
