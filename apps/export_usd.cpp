@@ -158,14 +158,23 @@ void writePointSamples(std::ostream& out, const std::vector<int>& frames,
         out, "int64[] ids", frames, [&](int f, std::string& text) { appendIntegers(text, samplesOf(f).id); }, progress);
 }
 
-// A fluid surface series: points, topology, extent and (where its meshes carry them) velocities, all sampled.
+// The colour of the fluid whose surface series `kind` is: surface the first fluid's, surface_<name> that fluid's.
+Eigen::Vector3d surfaceColor(const Scene& scene, const std::string& kind) {
+  if (scene.fluids.empty()) return scene.render.water_color;
+  for (size_t b : scene.laterFluids())
+    if (kind == "surface_" + scene.fluids[b].name) return scene.fluidColor(b);
+  return scene.fluidColor(0);
+}
+
+// A fluid surface series: points, topology, extent and (where its meshes carry them) velocities, all sampled, in
+// its fluid's colour.
 void writeSurface(std::ostream& out, const ExportRun& run, const FrameSeries& series, Progress& progress) {
   auto mesh = [&](int frame) { return readMeshPly(framePath(run.dir, series.kind, frame, "ply")); };
   TriangleMesh first;
   for (int f : series.frames)
     if (!(first = mesh(f)).triangles.empty()) break;
   std::string color;
-  appendTuple(color, run.scene.render.water_color);
+  appendTuple(color, surfaceColor(run.scene, series.kind));
   out << "    def Mesh \"" << primName(series.kind) << "\"\n    {\n"
       << "        uniform token subdivisionScheme = \"none\"\n"
       << "        uniform token orientation = \"" << orientation(first) << "\"\n"

@@ -310,8 +310,12 @@ class JsonWriter : public SceneVisitor {
     (*stack_.back())[key] = values;
   }
   void integer(const char* key, int& value, const FieldInfo&) override { (*stack_.back())[key] = value; }
-  void real(const char* key, double& value, const FieldInfo&) override { (*stack_.back())[key] = value; }
-  void vector(const char* key, Eigen::Vector3d& value, const FieldInfo&, bool always3) override {
+  // A value the reader would refuse is a key's "not given" (a fluid's colour 0): left out, as the file left it.
+  void real(const char* key, double& value, const FieldInfo& info) override {
+    if (!outOfRange(value, info)) (*stack_.back())[key] = value;
+  }
+  void vector(const char* key, Eigen::Vector3d& value, const FieldInfo& info, bool always3) override {
+    if (value == Eigen::Vector3d::Zero() && outOfRange(0, info)) return;
     json array = json::array();
     for (int k = 0; k < (always3 ? 3 : dimensions_); ++k) array.push_back(value[k]);
     (*stack_.back())[key] = array;
@@ -340,6 +344,10 @@ class JsonWriter : public SceneVisitor {
   }
 
  private:
+  static bool outOfRange(double v, const FieldInfo& info) {
+    return v < info.min || (info.minExclusive && v <= info.min) || v > info.max;
+  }
+
   int dimensions_;
   json root_ = json::object();
   std::vector<json*> stack_;
@@ -541,6 +549,7 @@ fs::path writeStageSettings(const fs::path& dir, const std::string& stage, const
     throw std::logic_error("writeStageSettings: no stage '" + stage + "'");
   // The keys the stages read, and the stage's own section; the later stages read the whitewater where there is.
   std::vector<std::string> keys = {"dimensions", "domain", "particle_spacing", "colliders", "bodies", stage};
+  if (stage == "render") keys.push_back("fluids");  // their colours and absorption distances
   if (stage == "whitewater") keys = {"dimensions", "domain", "particle_spacing", "gravity", "solver", stage};
   else if (scene.whitewater.enabled) keys.push_back("whitewater");
   Scene copy = scene;

@@ -148,7 +148,10 @@ struct FluidBlock {
   // The fluid it is (blocks of one name are one fluid). Empty in the file: "water" (resolved).
   std::string name;
   double rest_density = 0;  // kg/m^3 (kg/m^2 in 2D); 0 in the file: solver.rest_density (resolved)
-  Eigen::Vector3d color = Eigen::Vector3d::Zero();  // the render's water colour; zero: render.water_color (resolved)
+  // The render's water colour, reached after absorption_distance (m). Not resolved: zero and 0 stand for
+  // render.water_color and render.absorption_distance (Scene::fluidColor), so that a run's render follows those.
+  Eigen::Vector3d color = Eigen::Vector3d::Zero();
+  double absorption_distance = 0;
   double jitter = 0;  // each particle off its lattice site by up to jitter x half the spacing per axis (<= 0.5)
 
   bool shaped() const { return !solid.shape.empty(); }
@@ -296,6 +299,10 @@ struct Scene {
   bool densitiesDiffer() const;
   // The first block of every fluid after the first, in order (none in a scene of one fluid).
   std::vector<size_t> laterFluids() const;
+  // Block i's colour in the render and the distance over which white light takes it: its own, or the render's
+  // water_color and absorption_distance where it gives none.
+  Eigen::Vector3d fluidColor(size_t block) const;
+  double fluidAbsorptionDistance(size_t block) const;
   // The rest density of the particles that are not told apart: the first block's, or solver.rest_density
   // without blocks.
   double referenceDensity() const { return fluids.empty() ? solver.rest_density : fluids.front().rest_density; }

@@ -223,6 +223,11 @@ void visitScene(Scene& s, SceneVisitor& v) {
         v.vector("color", f.color,
                  atLeast(0.001, "that fluid's colour in the render, as render.water_color (not given: that)", "", 1),
                  true);
+        v.real("absorption_distance", f.absorption_distance,
+               positive("the distance over which that fluid absorbs white light to its colour, as "
+                        "render.absorption_distance (not given: that); a strongly coloured liquid such as oil takes "
+                        "its colour in centimetres where clear water takes metres",
+                        "m"));
         v.real("jitter", f.jitter,
                atLeast(0, "each particle starts off its lattice site by up to this fraction of half the spacing "
                           "along each axis (a fixed pattern, by particle): a square lattice's rows can then not "

@@ -117,7 +117,6 @@ void validateFluids(Scene& s, const std::string& where) {
     if (!std::all_of(fluid.name.begin(), fluid.name.end(), [](char c) { return std::isalnum(uint8_t(c)) || c == '_' || c == '-'; }))
       throw InputError(where, key + ".name", "'" + fluid.name + "' may hold only letters, digits, _ and -");
     if (fluid.rest_density == 0) fluid.rest_density = s.solver.rest_density;
-    if (fluid.color == Eigen::Vector3d::Zero()) fluid.color = s.render.water_color;
     if (i >= kMostFluids) throw InputError(where, key, "a scene holds at most 255 fluid blocks");
     const FluidBlock& first = s.fluids[s.fluidOf(i)];
     if (fluid.rest_density != first.rest_density)
@@ -125,9 +124,15 @@ void validateFluids(Scene& s, const std::string& where) {
                        formatNumber(fluid.rest_density) + " differs from fluids[" + std::to_string(s.fluidOf(i)) +
                            "]'s " + formatNumber(first.rest_density) + ", a block of the same fluid '" + fluid.name +
                            "': give it another name");
-    if (fluid.color != first.color)
+    if (s.fluidColor(i) != s.fluidColor(s.fluidOf(i)))
       throw InputError(where, key + ".color",
                        "differs from fluids[" + std::to_string(s.fluidOf(i)) + "]'s, a block of the same fluid '" +
+                           fluid.name + "': give it another name");
+    if (s.fluidAbsorptionDistance(i) != s.fluidAbsorptionDistance(s.fluidOf(i)))
+      throw InputError(where, key + ".absorption_distance",
+                       formatNumber(s.fluidAbsorptionDistance(i)) + " differs from fluids[" +
+                           std::to_string(s.fluidOf(i)) + "]'s " +
+                           formatNumber(s.fluidAbsorptionDistance(s.fluidOf(i))) + ", a block of the same fluid '" +
                            fluid.name + "': give it another name");
     if (fluid.viscosity != first.viscosity)
       throw InputError(where, key + ".viscosity",
@@ -381,6 +386,16 @@ bool Scene::severalFluids() const {
 bool Scene::densitiesDiffer() const {
   return std::any_of(fluids.begin(), fluids.end(),
                      [&](const FluidBlock& f) { return f.rest_density != referenceDensity(); });
+}
+
+Eigen::Vector3d Scene::fluidColor(size_t block) const {
+  const Eigen::Vector3d& own = fluids[block].color;
+  return own == Eigen::Vector3d::Zero() ? render.water_color : own;
+}
+
+double Scene::fluidAbsorptionDistance(size_t block) const {
+  const double own = fluids[block].absorption_distance;
+  return own == 0 ? render.absorption_distance : own;
 }
 
 std::vector<size_t> Scene::laterFluids() const {

@@ -193,7 +193,7 @@ std::vector<FluidMesh> otherFluidMeshes(const fs::path& dir, const Scene& scene,
   for (size_t b : scene.laterFluids()) {
     FluidMesh other;
     other.mesh = readMeshPly(fluidMeshPath(framePath(dir, "surface", frame, "ply"), scene.fluids[b].name));
-    other.absorption = Shading::absorptionOf(scene.fluids[b].color, scene.render.absorption_distance);
+    other.absorption = Shading::absorptionOf(scene.fluidColor(b), scene.fluidAbsorptionDistance(b));
     others.push_back(std::move(other));
   }
   return others;

@@ -198,10 +198,12 @@ Shading Shading::fromScene(const Scene& scene) {
   s.belowHorizon = 0.5f * s.skyHorizon;
   // The first fluid's colour (render.water_color unless it gives its own), or water's in a scene fed only by
   // emitters.
-  s.waterAbsorption = absorptionOf(scene.fluids.empty() ? r.water_color : scene.fluids[0].color, r.absorption_distance);
+  s.waterAbsorption = scene.fluids.empty() ? absorptionOf(r.water_color, r.absorption_distance)
+                                           : absorptionOf(scene.fluidColor(0), scene.fluidAbsorptionDistance(0));
   if (scene.severalFluids()) {  // in the order of the meshes: the first fluid's, then Scene::laterFluids
     s.fluidAbsorption.push_back(s.waterAbsorption);
-    for (size_t b : scene.laterFluids()) s.fluidAbsorption.push_back(absorptionOf(scene.fluids[b].color, r.absorption_distance));
+    for (size_t b : scene.laterFluids())
+      s.fluidAbsorption.push_back(absorptionOf(scene.fluidColor(b), scene.fluidAbsorptionDistance(b)));
   }
   s.tankMin = scene.domain.min.cast<float>();
   s.tankMax = scene.domain.max.cast<float>();

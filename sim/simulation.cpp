@@ -558,10 +558,13 @@ SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderSha
 }
 
 // A resumed simulation must go on with the physics it started with: the scene may change its name, its
-// surfacing, its rendering and its number of frames, nothing else.
+// surfacing, its rendering (the fluids' colours among it) and its number of frames, nothing else.
 static void checkResumable(const fs::path& previous, const std::string& previousJson, const std::string& json) {
   auto physics = [](nlohmann::json scene) {
     for (const char* key : {"name", "surface", "render"}) scene.erase(key);
+    if (scene.contains("fluids"))
+      for (auto& fluid : scene["fluids"])
+        for (const char* key : {"color", "absorption_distance"}) fluid.erase(key);
     if (scene.contains("output")) scene["output"].erase("frames");
     return scene;
   };

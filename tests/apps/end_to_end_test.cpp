@@ -159,6 +159,43 @@ TEST(EndToEnd, ResumedRunRedoesOnlyWhatIsMissingAndEndsOnTheSameBytes) {
   fs::remove_all(out);
 }
 
+// A fluid's colour and absorption distance are its look, not its physics: a run resumed with them changed renders
+// its frames again and leaves its particles and surfaces, and a fluid that gives no colour follows the render's
+// water_color when the run's folder is rendered again (the folder's scene.json leaves it unset).
+TEST(EndToEnd, AFluidsColourIsALookToChangeOnARun) {
+  const fs::path scene = writeTestScene("tiny.json", kTinyScene);
+  const fs::path out = fs::path(testing::TempDir()) / ("surge_e2e_colour_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  ASSERT_EQ(runSurge("run '" + scene.string() + "' --out '" + out.string() + "' --quiet").status, 0);
+  const fs::path particles = framePath(out, "particles", 2, "ply"), surface = framePath(out, "surface", 2, "ply");
+  const fs::path png = framePath(out, "frames", 2, "png");
+  const auto particleTime = fs::last_write_time(particles), surfaceTime = fs::last_write_time(surface);
+  const std::string blue = readTextFile(png);
+
+  const SurgeResult green =
+      runSurge("render '" + out.string() + "' --set 'render.water_color=[0.2, 0.9, 0.2]' --quiet");
+  ASSERT_EQ(green.status, 0) << green.err;
+  EXPECT_TRUE(readTextFile(png) != blue) << "the render's water_color did not reach the run's fluid";
+
+  const SurgeResult amber = runSurge("run '" + scene.string() +
+                                     "' --resume --set 'fluids[0].color=[0.9, 0.5, 0.1]' --set "
+                                     "fluids[0].absorption_distance=0.05 --out '" +
+                                     out.string() + "' --quiet");
+  ASSERT_EQ(amber.status, 0) << amber.err;
+  const std::string amberFrame = readTextFile(png);
+  EXPECT_TRUE(amberFrame != blue) << "the fluid's colour did not reach the render";
+  EXPECT_EQ(fs::last_write_time(particles), particleTime) << "a colour made the simulation run again";
+  EXPECT_EQ(fs::last_write_time(surface), surfaceTime) << "a colour made the surfaces stale";
+  // Rendered again at the same colour, the frame is the same: the change above was the colour's.
+  const SurgeResult again = runSurge("run '" + scene.string() +
+                                     "' --set 'fluids[0].color=[0.9, 0.5, 0.1]' --set "
+                                     "fluids[0].absorption_distance=0.05 --out '" +
+                                     out.string() + "' --quiet");
+  ASSERT_EQ(again.status, 0) << again.err;
+  EXPECT_TRUE(readTextFile(png) == amberFrame) << "a resumed render differs from a new run's";
+  fs::remove_all(out);
+}
+
 TEST(EndToEnd, BadSceneIsOneLineExitTwoAndWritesNothing) {
   std::string text = kTinyScene;
   text.replace(text.find("\"particle_spacing\": 0.03"), 24, "\"particle_spacing\": -1");

@@ -26,7 +26,7 @@ SCENE = {
     "name": "export_check", "dimensions": 3,
     "domain": {"min": [0, 0, 0], "max": [0.6, 0.5, 0.4]},
     "particle_spacing": 0.025,
-    "fluids": [{"box": {"min": [0, 0, 0], "max": [0.3, 0.25, 0.4]}}],
+    "fluids": [{"box": {"min": [0, 0, 0], "max": [0.3, 0.25, 0.4]}, "color": [0.9, 0.5, 0.1]}],
     "colliders": [
         {"name": "post", "shape": "cylinder", "position": [0.5, 0.15, 0.2], "radius": 0.04, "height": 0.3},
         {"name": "paddle", "shape": "box", "size": [0.03, 0.2, 0.3], "position": [0.4, 0.2, 0.2],

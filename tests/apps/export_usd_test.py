@@ -92,6 +92,9 @@ def check_stage(run):
     check(particles["widths"] == [SCENE["particle_spacing"]], f"widths {particles['widths']}")
 
     surface = prims[root + "/surface"]
+    # The fluid's own colour (fluids[0].color), not the render's water_color.
+    check(surface.get("primvars:displayColor") == [SCENE["fluids"][0]["color"]],
+          f"surface colour {surface.get('primvars:displayColor')}")
     for frame in range(FRAMES + 1):
         ply, faces = read_ply(frame_ply(run, "surface", frame))
         points = np.array(surface["points"][frame], dtype=np.float32)

@@ -229,6 +229,14 @@ TEST(SeveralFluids, BadInputNamesTheKey) {
   EXPECT_EQ(errorOf("[{" + box + R"(}, {)" + box + R"(, "name": "oil", "rest_density": 800}])", "dfsph"), "no error");
   EXPECT_NE(errorOf("[{" + box + R"(}, {)" + box + R"(, "color": [1, 0, 0]}])").find("fluids[1].color"),
             std::string::npos);
+  EXPECT_NE(errorOf("[{" + box + R"(, "absorption_distance": 0}])").find("fluids[0].absorption_distance"),
+            std::string::npos);
+  EXPECT_NE(errorOf("[{" + box + R"(}, {)" + box + R"(, "absorption_distance": 0.01}])")
+                .find("fluids[1].absorption_distance"),
+            std::string::npos);
+  // A block that gives the render's own colour and distance is the same fluid as one that gives none.
+  EXPECT_EQ(errorOf("[{" + box + R"(}, {)" + box + R"(, "color": [0.15, 0.45, 0.8], "absorption_distance": 0.25}])"),
+            "no error");
 }
 
 // Where the fluids' densities differ PBF iterates to a density error of 0.1% (at most 30 times) without s_corr,
