@@ -238,8 +238,8 @@ std::vector<std::string> solverNotes(const Scene& scene) {
         "adhesion is calibrated in DFSPH (a drop on a plate at 117, 93, 61 degrees for adhesion 0.25, 0.5, "
         "0.75 at 2.5 spacings of kernel support; Young's 120, 90, 60); in " +
         name + " the same drop reads " + method.adhesionAngles +
-        " degrees: its angle answers the adhesion about two thirds as much as Young's does "
-        "(docs/surface-tension.md)");
+        " degrees: its contact line comes to rest anywhere within a wider band about Young's angle than DFSPH's, "
+        "and a drop set down square rests at the band's edge (docs/surface-tension.md, \"Advancing and receding\")");
   }
   // In 2D each method's angles are measured at its own 2D support (FluidMethod::adhesionAngles2d).
   if (adhesion && scene.dimensions == 2 && method.adhesionAngles2d) {
