@@ -110,8 +110,10 @@ class Colliders {
   // Collider c's share of sum_b W(p - p_b) (weight) and sum_b grad_p W(p - p_b) (gradient) at p, at distance d
   // along the normal n. A box (boxTerms) counts the lattice beyond its faces, edges and corners exactly, by
   // the tank's tables; every other shape counts the flat wall's, less what it shares with a tank wall it stands
-  // square on.
-  void wallTerms(size_t c, const VecD& p, float d, const VecD& n, float& weight, VecD& gradient) const {
+  // square on (`sharesTank`: the tank's walls count the lattice beyond them, TankWalls::add; WCSPH's mirror images
+  // of the fluid do not).
+  void wallTerms(size_t c, const VecD& p, float d, const VecD& n, float& weight, VecD& gradient,
+                 bool sharesTank = true) const {
     if (placed_[c].exactBox && d > 0) {
       boxTerms(placed_[c], p, weight, gradient);
       return;
@@ -120,7 +122,7 @@ class Colliders {
     tank_->flatWall().lookup(d, w, g);
     weight = w;
     gradient = -g * n;
-    tank_->subtractOverlap(p, d, n, weight, gradient);
+    if (sharesTank) tank_->subtractOverlap(p, d, n, weight, gradient);
   }
 
   // WCSPH's pressure in the wall, continued from the particle's own by the hydrostatic gradient (Adami, Hu and
@@ -147,7 +149,8 @@ class Colliders {
   // A collider whose near box does not hold p is more than support + radius away, one that is not even a
   // candidate more than the grid's margin further; a particle far from all (farFrom) is given the support alone
   // (it is further), so that add runs for it again at the next pass, where its cell check is all it costs.
-  void add(const VecD& p, float& weight, VecD& gradient, Found& found, VecD& onlyGradient) const {
+  void add(const VecD& p, float& weight, VecD& gradient, Found& found, VecD& onlyGradient,
+           bool sharesTank = true) const {
     found = Found{support_ + radius_ + kGridMargin * radius_, 0, 0};
     const bool near = forEachCandidate(
         p,
@@ -156,7 +159,7 @@ class Colliders {
           if (d >= support_) return;
           float w;
           VecD g;
-          wallTerms(c, p, d, n, w, g);
+          wallTerms(c, p, d, n, w, g, sharesTank);
           weight += w;
           gradient += g;
           if (found.count++ == 0) {
@@ -167,10 +170,10 @@ class Colliders {
         [&] { found.clearance = std::min(found.clearance, support_ + radius_); });
     if (!near) found.clearance = support_;
   }
-  void add(const VecD& p, float& weight, VecD& gradient) const {
+  void add(const VecD& p, float& weight, VecD& gradient, bool sharesTank = true) const {
     Found unused;
     VecD unusedGradient;
-    add(p, weight, gradient, unused, unusedGradient);
+    add(p, weight, gradient, unused, unusedGradient, sharesTank);
   }
 
   // True if nothing stops a move from `from`, where add found `found`, to p: every point of the move stays a

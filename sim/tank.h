@@ -176,9 +176,11 @@ class TankWalls {
       if (nearAWall) addCorners(p, weight, gradient);
   }
 
-  // The walls' share of sum_b (g . (x_b - x_i)) grad W(x_i - x_b): WCSPH's wall pressure continued
-  // hydrostatically into the walls, as a collider's (Colliders::hydrostaticSum). Faces less the edges' quarters,
-  // as add() counts them; a corner's eighth has no tabulated moments and is left out, as at a box collider's.
+  // The walls' share of sum_b (g . (x_b - x_i)) grad W(x_i - x_b), the pressure continued hydrostatically into
+  // the lattice beyond them: faces less the edges' quarters, as add() counts them (a corner's eighth has no
+  // tabulated moments and is left out). WCSPH's colliders sum the same flat and edge moments (Colliders::
+  // hydrostaticSum); its tank walls mirror the fluid instead (sim/wcsph_solver.cpp), and tests/sim/tank_test.cpp
+  // holds the moments to the lattice through this sum.
   VecD hydrostaticSum(const VecD& p, const VecD& g) const {
     VecD sum = VecD::Zero();
     forEachFaceAndEdge(
@@ -204,6 +206,19 @@ class TankWalls {
     // The table's r points away from the quarter on both axes; here r_a has the sign -towards[a].
     m(axes[0], axes[1]) = m(axes[1], axes[0]) = towards[0] * towards[1] * e[3];
     return -(m * g);
+  }
+
+  // The walls closer to p than `reach`, at most one an axis (the nearer): their axes and the coordinates of their
+  // planes; returns how many (WCSPH's mirror images, sim/wcsph_solver.cpp).
+  int nearPlanes(const VecD& p, float reach, int axes[Dim], float planes[Dim]) const {
+    int count = 0;
+    for (int k = 0; k < Dim; ++k) {
+      const float below = p[k] - domainMin_[k], above = domainMax_[k] - p[k];
+      if (std::min(below, above) >= reach) continue;
+      axes[count] = k;
+      planes[count++] = below <= above ? domainMin_[k] : domainMax_[k];
+    }
+    return count;
   }
 
   // The share of one flat wall at distance d (the table above): see FlatWallTable.

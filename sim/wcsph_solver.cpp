@@ -7,6 +7,49 @@
 #include "core/parallel.h"
 
 namespace surge {
+namespace {
+
+// Calls f(j, offset, shift) for the mirror images of particle i and of its neighbours across the tank's walls
+// within the support of i (each wall, and each pair and triple of them where they meet): offset = x_i - x_j',
+// shift = x_j' - x_j, for the images closer to i than the support. An image is never closer to i than its
+// particle, so i's neighbours hold every image within reach.
+template <int Dim, typename Wrap, typename F>
+void forEachWallImage(const TankWalls<Dim>& walls, const std::vector<Vec<Dim>>& x, const NeighborLists& neighbors,
+                      size_t i, float support, const Wrap& wrap, F&& f) {
+  int axes[Dim];
+  float planes[Dim];
+  const int count = walls.nearPlanes(x[i], support, axes, planes);
+  if (count == 0) return;
+  const float reach2 = support * support;
+  const auto images = [&](size_t j, const Vec<Dim>& offset) {
+    // Across wall b the image lies `across[b]` from i along the wall's axis; beyond the support, no image
+    // across b reaches i.
+    float across[Dim];
+    int reaching = 0;
+    for (int b = 0; b < count; ++b) {
+      across[b] = x[i][axes[b]] + x[j][axes[b]] - 2 * planes[b];
+      if (across[b] * across[b] < reach2) reaching |= 1 << b;
+    }
+    for (int set = 1; set < (1 << count); ++set) {
+      if (set & ~reaching) continue;
+      Vec<Dim> o = offset, shift = Vec<Dim>::Zero();
+      for (int b = 0; b < count; ++b)
+        if (set >> b & 1) {
+          o[axes[b]] = across[b];
+          shift[axes[b]] = 2 * (planes[b] - x[j][axes[b]]);
+        }
+      if (o.squaredNorm() < reach2) f(j, o, shift);
+    }
+  };
+  images(i, Vec<Dim>::Zero());
+  for (const uint32_t* j = neighbors.begin(i); j != neighbors.end(i); ++j) {
+    Vec<Dim> offset = x[i] - x[*j];
+    wrap(offset);
+    images(*j, offset);
+  }
+}
+
+}  // namespace
 
 // The mass gives the rest lattice exactly rho_0 (the same choice as PBF's, with this kernel).
 template <int Dim>
@@ -181,8 +224,12 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
         }
       }
       VecD unusedGradient = VecD::Zero();
-      walls_.add(x_[i], weight, unusedGradient);
-      if (!colliders_.empty()) colliders_.add(x_[i], weight, unusedGradient);
+      if (mirroredWalls_)
+        forEachWallImage(walls_, x_, neighbors_, i, support_, wrap,
+                         [&](size_t, const VecD& o, const VecD&) { weight += kernel.value(o.norm()); });
+      else
+        walls_.add(x_[i], weight, unusedGradient);
+      if (!colliders_.empty()) colliders_.add(x_[i], weight, unusedGradient, !mirroredWalls_);
       density_[i] = mass_ * weight;
       const float ratio = density_[i] / restDensity_;
       float p = tait_ ? taitB_ * (std::pow(ratio, 7.0f) - 1.0f) : gasConstant_ * (density_[i] - restDensity_);
@@ -227,28 +274,36 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
           nearForce += (pairMass() * (nearPressure_[i] + nearPressure_[*j]) * d * d * inverseSupport / length) * r;
         }
       }
-      // The walls as mirrored particles with this particle's pressure continued hydrostatically, as the
-      // colliders' below (TankWalls::hydrostaticSum). With surface tension the particle's own pressure once
-      // (Akinci 2012): the cohesion holds particles at a wall with its own pressure, where the mirrored wall's
-      // second share stands them off it and feeds their motion (docs/surface-tension.md, "WCSPH's walls with surface
-      // tension").
-      float unusedWeight = 0;
-      VecD wallGradient = VecD::Zero();
-      walls_.add(x_[i], unusedWeight, wallGradient);
+      // The tank's walls. Without surface tension, the mirror images of the fluid beside them (forEachWallImage),
+      // each with its particle's pressure continued by the hydrostatic gradient to where the image stands (its
+      // height's, beyond a floor; the same beside a side wall, which then holds none of the water's weight).
+      // With surface tension the particle's own pressure once (Akinci 2012): the cohesion holds particles at a
+      // wall with its own pressure, where a mirrored wall's second share stands them off it and feeds their
+      // motion (docs/surface-tension.md, "WCSPH's walls with surface tension").
+      if (mirroredWalls_) {
+        forEachWallImage(walls_, x_, neighbors_, i, support_, wrap, [&](size_t j, const VecD& o, const VecD& shift) {
+          const float trueDensity = several ? density_[j] * massRatio[j] : density_[j];
+          const float image = std::max(pressure_[j] + trueDensity * gravity_.dot(shift), 0.0f);
+          pressureForce -=
+              (pressureTermI + image / (density_[j] * density_[j])) * (kernel.gradientFactor(o.norm()) * o);
+        });
+      } else {
+        float unusedWeight = 0;
+        VecD wallGradient = VecD::Zero();
+        walls_.add(x_[i], unusedWeight, wallGradient);
+        pressureForce -= pressureTermI * wallGradient;
+      }
       // The walls' pressure continued at the particle's own density, m_i / m_0 times density_.
       const float hydrostaticScale = (several ? massRatio[i] : 1.0f) / density_[i];
-      if (mirroredWalls_)
-        pressureForce -=
-            2.0f * pressureTermI * wallGradient + hydrostaticScale * walls_.hydrostaticSum(x_[i], gravity_);
-      else
-        pressureForce -= pressureTermI * wallGradient;
-      // The colliders likewise, their pressure continued hydrostatically (Colliders::hydrostaticSum); each
-      // one's share is a force on the particle, recorded for colliders.csv.
+      // The colliders as the rest lattice beyond them, its pressure the particle's mirrored and continued
+      // hydrostatically (Adami's wall, Colliders::hydrostaticSum; with surface tension the particle's once); each
+      // one's share is a force on the particle, recorded for colliders.csv. Where one meets a tank wall, the
+      // lattice beyond both is the collider's alone: the images mirror the fluid only.
       if (!colliders_.empty())
         colliders_.forEachNear(x_[i], [&](size_t c, float d, const VecD& n) {
           float unused;
           VecD gradient;
-          colliders_.wallTerms(c, x_[i], d, n, unused, gradient);
+          colliders_.wallTerms(c, x_[i], d, n, unused, gradient, !mirroredWalls_);
           const VecD force = mirroredWalls_
                                  ? VecD(-2.0f * pressureTermI * gradient -
                                         hydrostaticScale * colliders_.hydrostaticSum(c, x_[i], d, n, gravity_))

@@ -1,12 +1,15 @@
 // Weakly compressible SPH (Monaghan 1994, "Simulating free surface flows with SPH"; Becker & Teschner 2007,
 // "Weakly compressible SPH for free surface flows"), in 2D and 3D, sharing the neighbour grid, the tank walls
 // and the frame loop with PBF. Per evaluation:
-//   density by summation     rho_i = sum_j m W_ij (+ the walls, sim/tank.h)
+//   density by summation     rho_i = sum_j m W_ij, plus the tank walls' mirror images of the fluid (and with
+//                            surface tension the rest lattice beyond them, sim/tank.h) and the colliders' lattice
 //   equation of state        Tait p = rho_0 c^2 / 7 ((rho / rho_0)^7 - 1), or the gas law p = k (rho - rho_0);
 //                            negative pressures are clamped to 0 so the free surface does not pull together
-//   symmetric pressure force a_i = -sum_j m (p_i / rho_i^2 + p_j / rho_j^2) grad W_ij, the walls' and the
-//                            colliders' pressure continued from p_i by the hydrostatic gradient (Adami et al.
-//                            2012, eq. 27; TankWalls::hydrostaticSum, Colliders::hydrostaticSum)
+//   symmetric pressure force a_i = -sum_j m (p_i / rho_i^2 + p_j / rho_j^2) grad W_ij, over the fluid and the
+//                            walls' images, an image's pressure its particle's continued by the hydrostatic
+//                            gradient to the image (so a side wall carries none of the water's weight); the
+//                            colliders' pressure continued from p_i by it (Adami et al. 2012, eq. 27;
+//                            Colliders::hydrostaticSum)
 //   viscosity                artificial (Monaghan 1992): Pi_ij = -alpha c h mu_ij / rho_ij for approaching pairs,
 //                            mu_ij = v_ij . x_ij / (|x_ij|^2 + 0.01 h^2); laminar (Morris et al. 1997), from
 //                            solver.kinematic_viscosity when no fluid gives its own: a_i += 2 (d + 2) nu
@@ -80,8 +83,9 @@ class WcsphSolver final : public ParticleSolver<Dim> {
 
   // Parameters.
   bool verlet_, tait_;
-  // The walls' and colliders' pressure: Adami's (the particle's mirrored and continued hydrostatically), or with
-  // surface tension Akinci 2012's (the particle's own once, the gradient of its compression energy).
+  // Without surface tension the tank's walls mirror the fluid (its images) and the colliders' pressure is Adami's
+  // (the particle's mirrored and continued hydrostatically); with it both take Akinci 2012's (the particle's own
+  // once, the gradient of its compression energy).
   bool mirroredWalls_;
   SphKernel<Dim> kernel_;
   float support_, smoothingLength_, speedOfSound_, gasConstant_, taitB_;

@@ -552,11 +552,10 @@ TEST(Colliders, SubmergedSphereFeelsArchimedesWcsph) {
   checkBuoyancy<2, WcsphSolver<2>>(scene, M_PI * 0.08 * 0.08, 2.5, 8.0);
 }
 
-// The same ball as PBF's, in 3D. WCSPH reads it +4.0% over rho g V (rho the water's mean; measured over 2.5-10 s,
-// and the same in a pool 0.5 m wide), once the tank's walls continue the pressure hydrostatically as the ball
-// does (TankWalls::hydrostaticSum); with the walls mirroring the particle's pressure it read +15.5%: the water
-// beside the walls missed the walls' share of its support and the pressure below the ball rose 13% over
-// hydrostatic (docs/colliders.md).
+// The same ball as PBF's, in 3D. WCSPH reads it -0.1% from rho g V (rho the water's mean) since its tank walls
+// mirror the fluid (session 66); +4.0% while they continued the particle's pressure into the lattice beyond them,
+// +15.5% while they mirrored the particle's pressure alone: the water beside the walls missed the walls' share of
+// its support and the pressure below the ball rose 13% over hydrostatic (docs/colliders.md).
 TEST(Colliders, SubmergedSphereFeelsArchimedesWcsph3d) {
   const Scene scene = makeScene(3, R"({"min": [0, 0, 0], "max": [0.3, 0.6, 0.3]})",
                                 R"([{"box": {"min": [0, 0, 0], "max": [0.3, 0.4, 0.3]}}])",
