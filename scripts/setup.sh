@@ -62,11 +62,6 @@ case "$action" in
     echo "surge setup: video at out/dam_break/dam_break.mp4"
     ;;
   test)
-    # ctest starts the longest tests first when it knows their times; a fresh build folder does not, and the
-    # suite's end waited on one long test while the other core idled. tests/ctest_costs.txt holds the tests
-    # over 10 s (seconds a run, from a fresh-clone run; scripts/ctest_costs.sh writes it again).
-    costs="$build_dir/Testing/Temporary/CTestCostData.txt"
-    [ -f "$costs" ] || { mkdir -p "$(dirname "$costs")" && cp tests/ctest_costs.txt "$costs"; }
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" --timeout 900 -LE scenes
     # The fuzz regression (docs/reliability.md): the readers built again with clang, ASan, UBSan and libFuzzer
     # in a folder of their own, and every committed corpus input run once.
