@@ -208,16 +208,16 @@ class TankWalls {
     return -(m * g);
   }
 
-  // The walls closer to p than `reach`, at most one an axis (the nearer): their axes and the coordinates of their
-  // planes; returns how many (WCSPH's mirror images, sim/wcsph_solver.cpp).
-  int nearPlanes(const VecD& p, float reach, int axes[Dim], float planes[Dim]) const {
+  // The walls closer to p than `reach` (both of an axis in a tank thinner than twice it): their axes and the
+  // coordinates of their planes; returns how many (WCSPH's mirror images, sim/wcsph_solver.cpp).
+  int nearPlanes(const VecD& p, float reach, int axes[2 * Dim], float planes[2 * Dim]) const {
     int count = 0;
-    for (int k = 0; k < Dim; ++k) {
-      const float below = p[k] - domainMin_[k], above = domainMax_[k] - p[k];
-      if (std::min(below, above) >= reach) continue;
-      axes[count] = k;
-      planes[count++] = below <= above ? domainMin_[k] : domainMax_[k];
-    }
+    for (int k = 0; k < Dim; ++k)
+      for (int side = 0; side < 2; ++side) {
+        if ((side == 0 ? p[k] - domainMin_[k] : domainMax_[k] - p[k]) >= reach) continue;
+        axes[count] = k;
+        planes[count++] = side == 0 ? domainMin_[k] : domainMax_[k];
+      }
     return count;
   }
 

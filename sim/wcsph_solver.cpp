@@ -10,28 +10,33 @@ namespace surge {
 namespace {
 
 // Calls f(j, offset, shift) for the mirror images of particle i and of its neighbours across the tank's walls
-// within the support of i (each wall, and each pair and triple of them where they meet): offset = x_i - x_j',
-// shift = x_j' - x_j, for the images closer to i than the support. An image is never closer to i than its
-// particle, so i's neighbours hold every image within reach.
+// within the support of i (each wall, and each pair and triple of them on different axes where they meet):
+// offset = x_i - x_j', shift = x_j' - x_j, for the images closer to i than the support. An image is never closer
+// to i than its particle, so i's neighbours hold every image within reach.
 template <int Dim, typename Wrap, typename F>
 void forEachWallImage(const TankWalls<Dim>& walls, const std::vector<Vec<Dim>>& x, const NeighborLists& neighbors,
                       size_t i, float support, const Wrap& wrap, F&& f) {
-  int axes[Dim];
-  float planes[Dim];
+  int axes[2 * Dim];
+  float planes[2 * Dim];
   const int count = walls.nearPlanes(x[i], support, axes, planes);
   if (count == 0) return;
+  // Bit b set where walls b and b + 1 face each other across one axis (a tank thinner than twice the support):
+  // a set holding both has no single image.
+  int facing = 0;
+  for (int b = 0; b + 1 < count; ++b)
+    if (axes[b] == axes[b + 1]) facing |= 1 << b;
   const float reach2 = support * support;
   const auto images = [&](size_t j, const Vec<Dim>& offset) {
     // Across wall b the image lies `across[b]` from i along the wall's axis; beyond the support, no image
     // across b reaches i.
-    float across[Dim];
+    float across[2 * Dim];
     int reaching = 0;
     for (int b = 0; b < count; ++b) {
       across[b] = x[i][axes[b]] + x[j][axes[b]] - 2 * planes[b];
       if (across[b] * across[b] < reach2) reaching |= 1 << b;
     }
     for (int set = 1; set < (1 << count); ++set) {
-      if (set & ~reaching) continue;
+      if ((set & ~reaching) || (set & (set >> 1) & facing)) continue;
       Vec<Dim> o = offset, shift = Vec<Dim>::Zero();
       for (int b = 0; b < count; ++b)
         if (set >> b & 1) {
