@@ -69,7 +69,9 @@ class DfsphSolver final : public ParticleSolver<Dim> {
   std::vector<float> pressures(bool withDivergence = false) const;
   // Both solves' pressures: without the divergence solve's, a drop at rest summed to -0.27 Pa, not zero
   // (docs/surface-tension.md, "Laplace's pressure").
-  std::vector<float> virialPressures() override { return this->pairVirialPressures(kernel_, pressures(true), {}); }
+  double virialPressureWithin(const Vec<Dim>& centre, float radius) override {
+    return this->pairVirialPressureWithin(kernel_, pressures(true), {}, VirialBall<Dim>{centre, radius});
+  }
 
  private:
   using Core = ParticleSolver<Dim>;

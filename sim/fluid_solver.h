@@ -95,10 +95,17 @@ class FluidSolver {
   // The implicit viscosity solve's iterations in the last step (0 explicit), or -1 without viscosity.
   virtual int lastViscosityIterations() const { return -1; }
   virtual float maxPressure() const { return NAN; }
-  // Each particle's mechanical pressure at the current positions: the virial of its pair forces, the method's
-  // pressure force and surface tension's, (1 / (2 d V_i)) sum_j x_ij . F_ij. Where cohesion holds the fluid, this
-  // is the pressure Laplace's law speaks of (docs/surface-tension.md). Empty for a method without pressures.
-  virtual std::vector<float> virialPressures() { return {}; }
+  // Irving and Kirkwood's mechanical pressure in a ball (a disc in 2D) of the fluid at the current positions:
+  // the virial x_ij . F_ij of every pair force (the method's pressure force and surface tension's cohesion and
+  // curvature), each pair counted by the share of the segment between its particles inside the ball, plus the
+  // momentum flux m v v of the particles inside, over d times the ball's volume. At rest it is the radial stress
+  // on the ball's surface; where cohesion holds the fluid, the pressure Laplace's law speaks of
+  // (docs/surface-tension.md, "Laplace's pressure"). NaN for a method without pressures.
+  virtual double virialPressureWithin(const Vec<Dim>& centre, float radius) {
+    (void)centre;
+    (void)radius;
+    return NAN;
+  }
   virtual PhaseTimes& phaseTimes() = 0;
   // The work the method's cohesive forces (surface tension, adhesion) did on the fluid since the last call (J):
   // surface energy turned into motion, which the energy account counts as a source's work.

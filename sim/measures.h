@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <vector>
 
 #include "core/parallel.h"
@@ -123,6 +124,29 @@ long firstParticleOutside(const std::vector<Vec<Dim>>& x, const std::vector<Vec<
            return first;
          }).index;
 }
+
+// A ball (a disc in 2D) over which Irving and Kirkwood's mechanical pressure is averaged
+// (FluidSolver::virialPressureWithin): a pair's virial counts by the share of the segment between its particles
+// inside the ball. `halfInside(x, r)` is that share of the pair's half at x, the segment from x to x - r / 2 (r =
+// x_i - x_j, so that the two halves' shares sum to the pair's).
+template <int Dim>
+struct VirialBall {
+  Vec<Dim> centre;
+  float radius;
+
+  float halfInside(const Vec<Dim>& x, const Vec<Dim>& r) const {
+    const Vec<Dim> a = x - centre, d = -0.5f * r;  // the half is a + t d, t in [0, 1]
+    const float dd = d.squaredNorm(), ad = a.dot(d), c = a.squaredNorm() - radius * radius;
+    if (dd == 0) return c < 0 ? 1.0f : 0.0f;
+    const float discriminant = ad * ad - dd * c;
+    if (discriminant <= 0) return 0;
+    const float root = std::sqrt(discriminant);
+    return std::max(0.0f, std::min(1.0f, (-ad + root) / dd) - std::max(0.0f, (-ad - root) / dd));
+  }
+  double volume() const {
+    return Dim == 2 ? M_PI * double(radius) * radius : 4.0 / 3.0 * M_PI * std::pow(double(radius), 3);
+  }
+};
 
 // The largest value of `values`, in parallel.
 inline float parallelMax(const std::vector<float>& values) {

@@ -245,38 +245,49 @@ void ParticleSolver<Dim>::restoreCarriedState(const std::vector<float>& state) {
 }
 
 template <int Dim>
-std::vector<float> ParticleSolver<Dim>::pairVirialPressures(const SphKernel<Dim>& kernel,
-                                                            const std::vector<float>& pressure,
-                                                            const std::vector<float>& density) {
+std::vector<double> ParticleSolver<Dim>::pairVirials(const SphKernel<Dim>& kernel, const std::vector<float>& pressure,
+                                                     const std::vector<float>& density, const VirialBall<Dim>& ball,
+                                                     const OtherPairForce& other) {
   const size_t n = x_.size();
   NeighborLists lists;
   grid_.findNeighbors(x_, kernel.radius(), lists);
-  std::vector<double> virial(n, 0.0);  // each particle's half of sum_j x_ij . F_ij
-  const auto rho = [&](size_t i) { return density.empty() ? restDensity_ : density[i]; };
-  const auto massOf = [&](size_t i) { return massRatio_.empty() ? mass_ : mass_ * massRatio_[i]; };
+  std::vector<double> virial(n, 0.0);
   kernel.visit([&](const auto& w) {
     periodic_.withNearestImage([&](const auto& sharedWrap) {
       parallelFor(0, n, [&](size_t b, size_t e) {
         const auto wrap = sharedWrap;  // the thread's own copy (sim/periodic.h)
         for (size_t i = b; i < e; ++i) {
-          const float termI = pressure[i] / (rho(i) * rho(i));
+          const float termI = pressure[i] / (densityOf(density, i) * densityOf(density, i));
           double sum = 0;
           for (const uint32_t* j = lists.begin(i); j != lists.end(i); ++j) {
             VecD r = x_[i] - x_[*j];
             wrap(r);
-            const float force = -massOf(i) * massOf(*j) * (termI + pressure[*j] / (rho(*j) * rho(*j))) *
-                                w.gradientFactor(r.norm());  // F_ij / |x_ij| . x_ij / |x_ij| ...
-            sum += double(force) * double(r.squaredNorm());  // ... so x_ij . F_ij
+            float force =
+                -massOf(i) * massOf(*j) * (termI + pressure[*j] / (densityOf(density, *j) * densityOf(density, *j)));
+            if (other) force += mass_ * mass_ * other(i, *j, r);
+            force *= w.gradientFactor(r.norm());  // F_ij / |x_ij| . x_ij / |x_ij| ...
+            sum += double(ball.halfInside(x_[i], r)) * double(force) * double(r.squaredNorm());  // ... so x_ij . F_ij
           }
           virial[i] = 0.5 * sum;
         }
       });
     });
   });
-  if (tension_.active()) tension_.addPairVirials(x_, lists, fluid_, virial);
-  std::vector<float> result(n);
-  for (size_t i = 0; i < n; ++i) result[i] = float(virial[i] * rho(i) / (Dim * massOf(i)));
-  return result;
+  if (tension_.active()) tension_.addPairVirials(x_, lists, fluid_, ball, virial);
+  return virial;
+}
+
+template <int Dim>
+double ParticleSolver<Dim>::pairVirialPressureWithin(const SphKernel<Dim>& kernel, const std::vector<float>& pressure,
+                                                     const std::vector<float>& density, const VirialBall<Dim>& ball,
+                                                     const OtherPairForce& other) {
+  const std::vector<double> virial = pairVirials(kernel, pressure, density, ball, other);
+  double sum = 0;  // in the particles' order, so the same bytes at any thread count
+  for (size_t i = 0; i < virial.size(); ++i) {
+    sum += virial[i];
+    if ((x_[i] - ball.centre).norm() < ball.radius) sum += massOf(i) * double(v_[i].squaredNorm());
+  }
+  return sum / (Dim * ball.volume());
 }
 
 template <int Dim>

@@ -178,11 +178,22 @@ class ParticleSolver : public FluidSolver<Dim> {
     periodic_.wrap(x_);
     return firstParticleOutside(x_, v_, walls_, speedLimit_);
   }
-  // virialPressures for a method whose pressure force is -m_i m_j (p_i / rho_i^2 + p_j / rho_j^2) grad W_ij
+  // virialPressureWithin for a method whose pressure force is -m_i m_j (p_i / rho_i^2 + p_j / rho_j^2) grad W_ij
   // (`density` empty: rho_0 for every particle), over neighbour lists of its own at x_; adhesion left out. With
   // several fluids DFSPH weights its pressure force by its density contrast, so there the figure is approximate.
-  std::vector<float> pairVirialPressures(const SphKernel<Dim>& kernel, const std::vector<float>& pressure,
-                                         const std::vector<float>& density);
+  // `other(i, j, r)`: the method's other pair force on i from j (its viscosity's) over m_0^2 grad W_ij, if any.
+  using OtherPairForce = std::function<float(size_t, size_t, const VecD&)>;
+  double pairVirialPressureWithin(const SphKernel<Dim>& kernel, const std::vector<float>& pressure,
+                                  const std::vector<float>& density, const VirialBall<Dim>& ball,
+                                  const OtherPairForce& other = {});
+  // Each particle's half of sum_j x_ij . F_ij, each pair's half counted by its share inside `ball`.
+  std::vector<double> pairVirials(const SphKernel<Dim>& kernel, const std::vector<float>& pressure,
+                                  const std::vector<float>& density, const VirialBall<Dim>& ball,
+                                  const OtherPairForce& other);
+  float densityOf(const std::vector<float>& density, size_t i) const {
+    return density.empty() ? restDensity_ : density[i];
+  }
+  float massOf(size_t i) const { return massRatio_.empty() ? mass_ : mass_ * massRatio_[i]; }
   // Bytes held by the shared channels, the grid, the lists and the colliders (capacities).
   size_t coreMemoryBytes() const;
 

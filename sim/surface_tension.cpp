@@ -267,7 +267,8 @@ void SurfaceTension<Dim>::colourAndNormals(const std::vector<VecD>& x, const Nei
 
 template <int Dim>
 void SurfaceTension<Dim>::addPairVirials(const std::vector<VecD>& x, const NeighborLists& neighbors,
-                                         const std::vector<uint8_t>& fluid, std::vector<double>& virial) {
+                                         const std::vector<uint8_t>& fluid, const VirialBall<Dim>& ball,
+                                         std::vector<double>& virial) {
   const auto passes = [&](auto severalFluids) {
     constexpr bool several = decltype(severalFluids)::value;
     periodic_.withNearestImage([&](const auto& sharedWrap) {
@@ -282,7 +283,7 @@ void SurfaceTension<Dim>::addPairVirials(const std::vector<VecD>& x, const Neigh
             if (several && fluid[*j] != f) continue;
             VecD r = x[i] - x[*j];
             wrap(r);
-            sum += double(r.dot(pairTerm(i, *j, r, m)));  // x_ij . a_ij / gamma
+            sum += double(ball.halfInside(x[i], r)) * double(r.dot(pairTerm(i, *j, r, m)));  // x_ij . a_ij / gamma
           }
           virial[i] += 0.5 * sum * fluidGamma_[f] * m;
         }

@@ -27,6 +27,7 @@
 #include "core/scene.h"
 #include "sim/colliders.h"
 #include "sim/kernels.h"
+#include "sim/measures.h"
 #include "sim/neighbor_grid.h"
 
 namespace surge {
@@ -80,10 +81,11 @@ class SurfaceTension {
   }
   size_t memoryBytes() const;
   // Adds to `virial` each particle's half of the virial of the model's pair forces at x, (1/2) sum_j x_ij . m
-  // a_ij (cohesion and curvature; adhesion left out): the model's share of the mechanical pressure
-  // (FluidSolver::virialPressures). Overwrites the colour and normals the accelerations were computed with.
+  // a_ij (cohesion and curvature; adhesion left out), each pair's half counted by its share inside `ball`: the
+  // model's share of the mechanical pressure (FluidSolver::virialPressureWithin). Overwrites the colour and
+  // normals the accelerations were computed with.
   void addPairVirials(const std::vector<VecD>& x, const NeighborLists& neighbors, const std::vector<uint8_t>& fluid,
-                      std::vector<double>& virial);
+                      const VirialBall<Dim>& ball, std::vector<double>& virial);
 
   // Kirkwood and Buff: sigma = (1 / 4A) sum_i sum_j (r_n F_n - r_t F_t) over the pairs of a column of a slab of
   // the rest lattice with two free faces (A the column's area, n across the slab, t along it), for gamma = 1.

@@ -389,6 +389,22 @@ FluidMeasures WcsphSolver<Dim>::measure() {
   });
 }
 
+template <int Dim>
+double WcsphSolver<Dim>::virialPressureWithin(const Vec<Dim>& centre, float radius) {
+  const float h = smoothingLength_, eta2 = 0.01f * h * h, laminar = 2.0f * (Dim + 2) * nu_;
+  const std::vector<float>& massRatio = this->massRatio_;
+  // The force pass's viscous terms for the pair (i, j), over m_0^2 grad W_ij.
+  const auto viscous = [&](size_t i, size_t j, const VecD& r) {
+    const float mu = (v_[i] - v_[j]).dot(r) / (r.squaredNorm() + eta2);
+    const float pairMass = massRatio.empty() ? 1.0f : 2.0f * massRatio[j] / (massRatio[i] + massRatio[j]);
+    float term = 0;
+    if (alpha_ > 0 && mu < 0) term += pairMass * alpha_ * speedOfSound_ * h * mu / (0.5f * (density_[i] + density_[j]));
+    if (nu_ > 0) term += pairMass * laminar * mu / density_[j];
+    return term;
+  };
+  return this->pairVirialPressureWithin(kernel_, pressure_, density_, VirialBall<Dim>{centre, radius}, viscous);
+}
+
 template class WcsphSolver<2>;
 template class WcsphSolver<3>;
 

@@ -64,7 +64,9 @@ class WcsphSolver final : public ParticleSolver<Dim> {
   double compressionEnergy() override;
   // Pressures of the last evaluation, in the particles' current order (for tests).
   const std::vector<float>& pressures() const { return pressure_; }
-  std::vector<float> virialPressures() override { return this->pairVirialPressures(kernel_, pressure_, density_); }
+  // With the pair viscosity's force (Monaghan's, Morris's): it pushes approaching pairs apart only, so that a drop
+  // that is not quite still holds a share of its pressure through it.
+  double virialPressureWithin(const Vec<Dim>& centre, float radius) override;
 
  private:
   using Core = ParticleSolver<Dim>;

@@ -5,20 +5,21 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
-
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <random>
 
-#include "sim/dfsph_solver.h"
-#include "sim/fluid_solver.h"
-#include "sim/simulation.h"
-#include "sim/wcsph_solver.h"
 #include "core/errors.h"
 #include "core/files.h"
 #include "core/parallel.h"
 #include "core/progress.h"
+#include "sim/dfsph_solver.h"
+#include "sim/fluid_solver.h"
+#include "sim/simulation.h"
 #include "sim/solver_defaults.h"
+#include "sim/wcsph_solver.h"
 #include "tests/sim/run_scene.h"
 #include "tests/sim/stats_columns.h"
 
@@ -64,6 +65,15 @@ ParticleFrame sphereDrop(int dim, double radius, double a) {
   return frame;
 }
 
+// Moves each particle of `frame` by up to `amount` along each axis of its plane or space, the same for a seed on
+// every machine (std::mt19937's raw draws are the standard's).
+void jitter(ParticleFrame& frame, double amount, uint32_t seed) {
+  std::mt19937 draw(seed);
+  for (auto& p : frame.position)
+    for (int axis = 0; axis < frame.dimensions; ++axis)
+      p[axis] += float(amount * (2.0 * double(draw()) / 4294967295.0 - 1.0));
+}
+
 // (C_xx - the other axes' mean) / trace of the drop's second moment about its centre.
 template <int Dim>
 double signedAnisotropy(const std::vector<Vec<Dim>>& x) {
@@ -103,8 +113,8 @@ void stepFor(FluidSolver<Dim>& solver, double& time, double duration, double mos
 // A drop of `radius` at rest in equilibrium: the lattice's sphere relaxed for `relax` seconds, its velocities
 // zeroed after every step (the staircase of its surface made smooth), in the solver's current order.
 template <int Dim>
-void relaxDrop(FluidSolver<Dim>& solver, double radius, double relax) {
-  solver.setParticles(sphereDrop(Dim, radius, 0));
+void relaxDrop(FluidSolver<Dim>& solver, double radius, double relax, const ParticleFrame& start = {}) {
+  solver.setParticles(start.size() > 0 ? start : sphereDrop(Dim, radius, 0));
   double time = 0;
   ParticleFrame frame;
   const int steps = 200;
@@ -228,44 +238,63 @@ TEST(SurfaceTension, A2DDropFirstSwingsAtRayleighsFrequencyInPbfAtItsDefaults) {
 
 // Laplace: a drop at rest holds a pressure (d - 1) sigma / R above the air's. The solver's own pressure holds the
 // fluid against the cohesion's pull, of order sigma / h, so the pressure Laplace's law speaks of is the mechanical
-// one, the virial of every pair force (FluidSolver::virialPressures). DFSPH 3D at its default support with surface
-// tension (2.5 spacings), R = 20 mm (40 particles across), the particles within R/2 over 0.2 s: within the issue's
-// 10% of 2 sigma / R (measured 1.064; a probe read 1.18, 1.17, 1.13, 1.06 and 1.05 at 8, 10, 12, 16 and 20 mm: the
-// excess falls as 1/R, and at 16 mm this procedure reads 1.087, too near the bound; docs/surface-tension.md).
-// Over the whole drop the virial of a system at rest sums to zero, less twice its kinetic energy: held to 2% of
-// Laplace's (measured -0.3%), so that every pressure force is in the measure. Without DFSPH's divergence solve's
-// pressure it read -3.7%.
-TEST(SurfaceTension, ADropsInnerPressureIsLaplacesInDfsph3DAtItsDefaults) {
-  const double radius = 0.02, laplace = 2 * kSigma / radius;
-  auto solver = makeFluidSolver<3>(dropScene(3, "dfsph", radius));
-  relaxDrop<3>(*solver, radius, 0.3);
-  ASSERT_FALSE(::testing::Test::HasFatalFailure());
-  double time = 0, inside = 0, whole = 0;
-  long insideCount = 0, wholeCount = 0;
-  for (int sample = 0; sample < 20; ++sample) {
-    stepFor<3>(*solver, time, 0.01, 1.0 / 120);
-    ASSERT_FALSE(::testing::Test::HasFatalFailure());
-    const std::vector<float> pressure = solver->virialPressures();
-    const auto& x = solver->positions();
-    ASSERT_EQ(pressure.size(), x.size());
-    Vec<3> centre = Vec<3>::Zero();
-    for (const auto& p : x) centre += p;
-    centre /= float(x.size());
-    for (size_t i = 0; i < x.size(); ++i) {
-      if ((x[i] - centre).norm() < radius / 2) {
-        inside += pressure[i];
-        ++insideCount;
-      }
-      whole += pressure[i];
-      ++wholeCount;
-    }
+// one, Irving and Kirkwood's of every pair force (FluidSolver::virialPressureWithin): in a ball about the drop's
+// centre, the radial stress on its surface, the same at every radius inside a fluid at rest. `start` relaxed for
+// 0.3 s, then `samples` over 0.2 s: the mean over them of the pressure in balls of R/4, R/2 and 3R/4 over
+// Laplace's, and of the whole drop's (a ball two supports wider), which at rest sums to zero, the kinetic energy
+// counted.
+template <int Dim>
+std::array<double, 4> laplaceRatios(FluidSolver<Dim>& solver, const ParticleFrame& start, double radius, double support,
+                                    int samples = 20) {
+  relaxDrop<Dim>(solver, radius, 0.3, start);
+  std::array<double, 4> ratio{};
+  if (::testing::Test::HasFatalFailure()) return ratio;
+  const double laplace = (Dim - 1) * kSigma / radius;
+  const std::array<double, 4> ball = {radius / 4, radius / 2, 3 * radius / 4, radius + 2 * support};
+  double time = 0;
+  for (int sample = 0; sample < samples; ++sample) {
+    stepFor<Dim>(solver, time, 0.2 / samples, 1.0 / 120);
+    if (::testing::Test::HasFatalFailure()) return ratio;
+    Vec<Dim> centre = Vec<Dim>::Zero();
+    for (const auto& p : solver.positions()) centre += p;
+    centre /= float(solver.size());
+    for (size_t k = 0; k < ball.size(); ++k)
+      ratio[k] += solver.virialPressureWithin(centre, float(ball[k])) / laplace / samples;
   }
-  inside /= double(insideCount);
-  whole /= double(wholeCount);
-  std::printf("inside %.3f Pa (%.3f of 2 sigma / R = %.3f Pa), the whole drop's mean %.3f Pa\n", inside,
-              inside / laplace, laplace, whole);
-  EXPECT_NEAR(inside / laplace, 1.0, 0.1);
-  EXPECT_LT(std::abs(whole), 0.02 * laplace);
+  std::printf("%dD, R = %.0f mm: over (d - 1) sigma / R, within R/4 %.3f, R/2 %.3f, 3R/4 %.3f; the whole drop %.4f\n",
+              Dim, radius * 1e3, ratio[0], ratio[1], ratio[2], ratio[3]);
+  return ratio;
+}
+
+// DFSPH 3D at its default support with surface tension (2.5 spacings), R = 20 mm (40 particles across): each
+// ball within the 10% (measured 1.084, 1.074, 1.090: the drop's inside at rest, its stress a pressure;
+// the particles' own halves of the virial within R/2, the measure before, read 1.064), and the whole drop to 2% of
+// Laplace's (measured 0.01%). With gamma 20% too large the measure read 1.258 and failed; without DFSPH's
+// divergence solve's pressure the whole drop read -3.7%.
+TEST(SurfaceTension, ADropsInnerPressureIsLaplacesInDfsph3DAtItsDefaults) {
+  const double radius = 0.02;
+  auto solver = makeFluidSolver<3>(dropScene(3, "dfsph", radius));
+  const std::array<double, 4> ratio = laplaceRatios<3>(*solver, sphereDrop(3, radius, 0), radius, 0.0025);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(ratio[k], 1.0, 0.1) << "ball " << k;
+  EXPECT_LT(std::abs(ratio[3]), 0.02);
+}
+
+// In 2D the inner pressure stays above the 10% at the sizes measured (WCSPH, 200 samples: 1.24 and 1.28
+// of sigma / R at R = 20 mm, 1.09 to 1.12 at 40; docs/surface-tension.md, "Laplace's pressure"), so the 2D check
+// holds the measure itself: WCSPH at its 2D support (4 spacings), R = 20 mm, a jittered start, sampled every
+// millisecond (the compressible drop breathes; 20 samples read the whole drop -4 to -7% at 40 mm by aliasing). The
+// whole drop's virial sums to zero within 1% of sigma / R (measured 0.01%, at most 0.02% in six runs at 20 to 40
+// mm) only with the pair viscosity's force counted, which pushes approaching pairs apart alone (without it -2.2%
+// here, -3.7 to -6.8% at 40 mm).
+TEST(SurfaceTension, A2DDropsVirialCountsEveryPairForceInWcsph) {
+  const double radius = 0.02;
+  auto solver = makeFluidSolver<2>(dropScene(2, "wcsph", radius));
+  ParticleFrame start = sphereDrop(2, radius, 0);
+  jitter(start, 0.25 * kSpacing, 1);
+  const std::array<double, 4> ratio = laplaceRatios<2>(*solver, start, radius, 0.004, 200);
+  ASSERT_FALSE(::testing::Test::HasFatalFailure());
+  EXPECT_LT(std::abs(ratio[3]), 0.01);
 }
 
 // The 2:1:1 box of water (24 x 12 x 12 particles at 1 mm) in zero gravity, in `method`.
