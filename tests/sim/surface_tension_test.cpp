@@ -283,10 +283,10 @@ TEST(SurfaceTension, ADropsInnerPressureIsLaplacesInDfsph3DAtItsDefaults) {
 // In 2D the inner pressure stays above the 10% at the sizes measured (WCSPH, 200 samples: 1.24 and 1.28
 // of sigma / R at R = 20 mm, 1.09 to 1.12 at 40; docs/surface-tension.md, "Laplace's pressure"), so the 2D check
 // holds the measure itself: WCSPH at its 2D support (4 spacings), R = 20 mm, a jittered start, sampled every
-// millisecond (the compressible drop breathes; 20 samples read the whole drop -4 to -7% at 40 mm by aliasing). The
-// whole drop's virial sums to zero within 1% of sigma / R (measured 0.01%, at most 0.02% in six runs at 20 to 40
-// mm) only with the pair viscosity's force counted, which pushes approaching pairs apart alone (without it -2.2%
-// here, -3.7 to -6.8% at 40 mm).
+// millisecond (the compressible drop breathes; 20 samples read the whole drop -3.7 to 0.0% at 40 mm by aliasing).
+// The whole drop's virial sums to zero within 1% of sigma / R (measured 0.01%, at most 0.12% in seven runs at 20
+// to 40 mm) only with the pair viscosity's force counted, which pushes approaching pairs apart alone (without it
+// -2.2% here; -4.9 to -6.8% at 40 mm and 20 samples).
 TEST(SurfaceTension, A2DDropsVirialCountsEveryPairForceInWcsph) {
   const double radius = 0.02;
   auto solver = makeFluidSolver<2>(dropScene(2, "wcsph", radius));
