@@ -193,6 +193,7 @@ class ParticleSolver : public FluidSolver<Dim> {
   float densityOf(const std::vector<float>& density, size_t i) const {
     return density.empty() ? restDensity_ : density[i];
   }
+  // Particle i's mass, m_0 times its fluid's mass ratio.
   float massOf(size_t i) const { return massRatio_.empty() ? mass_ : mass_ * massRatio_[i]; }
   // Bytes held by the shared channels, the grid, the lists and the colliders (capacities).
   size_t coreMemoryBytes() const;

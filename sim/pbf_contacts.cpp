@@ -14,7 +14,7 @@ namespace surge {
 template <int Dim>
 void PbfSolver<Dim>::collide(size_t i, const VecD& from, bool fromStepStart) {
   constexpr int kCornerRounds = 2;
-  const float mass = massRatio_.empty() ? mass_ : mass_ * massRatio_[i];
+  const float mass = this->massOf(i);
   auto pushed = [&](size_t c, const VecD& delta) { colliders_.addImpulse(i, c, (mass / stepDt_) * delta, p_[i]); };
   colliders_.project(from, p_[i], fromStepStart, pushed);
   for (int round = 0; round < kCornerRounds; ++round) {
@@ -29,8 +29,7 @@ void PbfSolver<Dim>::collide(size_t i, const VecD& from, bool fromStepStart) {
 template <int Dim>
 void PbfSolver<Dim>::applyFriction() {
   parallelFor(0, size(), [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i)
-      colliders_.applyFriction(i, p_[i], v_[i], massRatio_.empty() ? mass_ : mass_ * massRatio_[i]);
+    for (size_t i = b; i < e; ++i) colliders_.applyFriction(i, p_[i], v_[i], this->massOf(i));
   });
 }
 

@@ -298,13 +298,13 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
         walls_.add(x_[i], unusedWeight, wallGradient);
         pressureForce -= pressureTermI * wallGradient;
       }
-      // The walls' pressure continued at the particle's own density, m_i / m_0 times density_.
-      const float hydrostaticScale = (several ? massRatio[i] : 1.0f) / density_[i];
       // The colliders as the rest lattice beyond them, its pressure the particle's mirrored and continued
       // hydrostatically (Adami's wall, Colliders::hydrostaticSum; with surface tension the particle's once); each
       // one's share is a force on the particle, recorded for colliders.csv. Where one meets a tank wall, the
       // lattice beyond both is the collider's alone: the images mirror the fluid only.
-      if (!colliders_.empty())
+      if (!colliders_.empty()) {
+        // The colliders' pressure continued at the particle's own density, m_i / m_0 times density_.
+        const float hydrostaticScale = (several ? massRatio[i] : 1.0f) / density_[i];
         colliders_.forEachNear(x_[i], [&](size_t c, float d, const VecD& n) {
           float unused;
           VecD gradient;
@@ -316,6 +316,7 @@ void WcsphSolver<Dim>::computeAccelerationsWith(const Kernel& kernel, double tim
           pressureForce += force;
           colliders_.addImpulse(i, c, (mass_ * mass_) * force, x_[i]);
         });
+      }
       // m_0 (the pair sums) over m_i: the impulse on a collider, m_i times its share, is m_0^2 force either way.
       const float massScale = several ? mass_ * inverse[i] : mass_;
       VecD acceleration = gravity_ + massScale * (pressureForce + viscousForce) + (several ? inverse[i] : 1.0f) * nearForce;

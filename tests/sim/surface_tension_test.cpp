@@ -269,8 +269,9 @@ std::array<double, 4> laplaceRatios(FluidSolver<Dim>& solver, const ParticleFram
 // DFSPH 3D at its default support with surface tension (2.5 spacings), R = 20 mm (40 particles across): each
 // ball within the 10% (measured 1.084, 1.074, 1.090: the drop's inside at rest, its stress a pressure;
 // the particles' own halves of the virial within R/2, the measure before, read 1.064), and the whole drop to 2% of
-// Laplace's (measured 0.01%). With gamma 20% too large the measure read 1.258 and failed; without DFSPH's
-// divergence solve's pressure the whole drop read -3.7%.
+// Laplace's (measured 0.01%). Seen failing with the model's pairs counted wholly at the particle inside (the
+// measure before): 0.761, 0.993, 1.111. Before, with gamma 20% too large the particles' measure read 1.258, and
+// without DFSPH's divergence solve's pressure the whole drop read -3.7%.
 TEST(SurfaceTension, ADropsInnerPressureIsLaplacesInDfsph3DAtItsDefaults) {
   const double radius = 0.02;
   auto solver = makeFluidSolver<3>(dropScene(3, "dfsph", radius));
