@@ -54,6 +54,15 @@ class Simulation {
     return py::array_t<uint32_t>({py::ssize_t(run_->size())}, {py::ssize_t(sizeof(uint32_t))}, run_->ids(), self);
   }
 
+  double pressureWithin(const std::vector<double>& centre, double radius) const {
+    if (int(centre.size()) != run_->dimensions())
+      throw py::value_error("pressure_within: centre has " + std::to_string(centre.size()) + " values, the scene " +
+                            std::to_string(run_->dimensions()) + " dimensions");
+    if (!(radius > 0)) throw py::value_error("pressure_within: radius must be above 0");
+    const ThreadLimit limit(threads_);
+    return run_->pressureWithin(centre, radius);
+  }
+
   int frame() const { return run_->frame(); }
   double time() const { return run_->time(); }
   int dimensions() const { return run_->dimensions(); }
@@ -119,6 +128,11 @@ PYBIND11_MODULE(surge, m) {
            "(n, dimensions) float32 view of the velocities, in the order of positions()")
       .def("ids", [](py::object self) { return self.cast<const Simulation&>().ids(self); },
            "(n,) uint32 view of the particles' ids (each keeps its id for life), in the order of positions()")
+      .def("pressure_within", &Simulation::pressureWithin, py::arg("centre"), py::arg("radius"),
+           "Irving and Kirkwood's mechanical pressure in the ball (a disc in 2D) of `radius` about `centre` at the "
+           "newest frame: every pair force's virial by the share of its segment inside, plus the momentum flux of "
+           "the particles inside relative to their mean, over d times the ball's volume (Pa; N/m in 2D; NaN for "
+           "PBF, which has no pressures). Asking does not change the run")
       .def_property_readonly("frame", &Simulation::frame, "the newest frame written")
       .def_property_readonly("time", &Simulation::time, "its time in seconds")
       .def_property_readonly("dimensions", &Simulation::dimensions)

@@ -98,9 +98,9 @@ class FluidSolver {
   // Irving and Kirkwood's mechanical pressure in a ball (a disc in 2D) of the fluid at the current positions:
   // the virial x_ij . F_ij of every pair force (the method's pressure force and surface tension's cohesion and
   // curvature), each pair counted by the share of the segment between its particles inside the ball, plus the
-  // momentum flux m v v of the particles inside, over d times the ball's volume. At rest it is the radial stress
-  // on the ball's surface; where cohesion holds the fluid, the pressure Laplace's law speaks of
-  // (docs/surface-tension.md, "Laplace's pressure"). NaN for a method without pressures.
+  // momentum flux m v v of the particles inside, v relative to their mean, over d times the ball's volume. At
+  // rest it is the radial stress on the ball's surface; where cohesion holds the fluid, the pressure Laplace's law
+  // speaks of (docs/surface-tension.md, "Laplace's pressure"). NaN for a method without pressures.
   virtual double virialPressureWithin(const Vec<Dim>& centre, float radius) {
     (void)centre;
     (void)radius;

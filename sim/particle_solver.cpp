@@ -282,10 +282,20 @@ double ParticleSolver<Dim>::pairVirialPressureWithin(const SphKernel<Dim>& kerne
                                                      const std::vector<float>& density, const VirialBall<Dim>& ball,
                                                      const OtherPairForce& other) {
   const std::vector<double> virial = pairVirials(kernel, pressure, density, ball, other);
-  double sum = 0;  // in the particles' order, so the same bytes at any thread count
+  // The momentum flux is the particles' motion relative to the ball's mean (its mass's), so that a fluid moving
+  // as a whole reads the pressure it holds at rest. Sums in the particles' order: the same bytes at any thread count.
+  const auto inside = [&](size_t i) { return (x_[i] - ball.centre).norm() < ball.radius; };
+  Eigen::Matrix<double, Dim, 1> momentum = Eigen::Matrix<double, Dim, 1>::Zero();
+  double mass = 0, sum = 0;
+  for (size_t i = 0; i < x_.size(); ++i)
+    if (inside(i)) {
+      momentum += massOf(i) * v_[i].template cast<double>();
+      mass += massOf(i);
+    }
+  const Eigen::Matrix<double, Dim, 1> mean = mass > 0 ? Eigen::Matrix<double, Dim, 1>(momentum / mass) : momentum;
   for (size_t i = 0; i < virial.size(); ++i) {
     sum += virial[i];
-    if ((x_[i] - ball.centre).norm() < ball.radius) sum += massOf(i) * double(v_[i].squaredNorm());
+    if (inside(i)) sum += massOf(i) * (v_[i].template cast<double>() - mean).squaredNorm();
   }
   return sum / (Dim * ball.volume());
 }

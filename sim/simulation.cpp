@@ -243,6 +243,11 @@ class FrameLoop final : public SimulationRun {
   const float* velocities() const override { return method_->velocities().data()->data(); }
   const uint32_t* ids() const override { return method_->ids().data(); }
   const SimulationSummary& summary() const override { return summary_; }
+  double pressureWithin(const std::vector<double>& centre, double radius) override {
+    Vec<Dim> c;
+    for (int k = 0; k < Dim; ++k) c[k] = static_cast<float>(centre.at(k));
+    return method_->virialPressureWithin(c, static_cast<float>(radius));
+  }
 
   bool stepFrame() override {
     if (frameIndex_ >= scene_.output.frames) return false;

@@ -91,6 +91,10 @@ class SimulationRun {
   virtual const float* velocities() const = 0;
   virtual const uint32_t* ids() const = 0;
   virtual const SimulationSummary& summary() const = 0;
+  // Irving and Kirkwood's pressure in the ball of `radius` about `centre` (Dim values) at the newest frame
+  // (FluidSolver::virialPressureWithin): Pa in 3D, N/m in 2D; NaN for a method without pressures. The run goes on
+  // the same bytes whether it is asked or not.
+  virtual double pressureWithin(const std::vector<double>& centre, double radius) = 0;
 };
 
 SimulationSummary simulate(const Scene& scene, std::shared_ptr<const ColliderShapes> shapes, const fs::path& dir,

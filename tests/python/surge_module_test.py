@@ -92,3 +92,52 @@ def test_a_resume_goes_on_only_with_the_physics_it_started_with(tmp_path):
     while sim.step_frame():
         pass
     assert frames(tmp_path) == ["frame_00000.ply", "frame_00001.ply", "frame_00002.ply"]
+
+
+COLUMN = """{"name": "column", "dimensions": 2, "domain": {"min": [0, 0], "max": [0.2, 0.4]},
+  "particle_spacing": 0.01, "fluids": [{"box": {"min": [0, 0], "max": [0.2, 0.3]}}], "gravity": [0, -9.81],
+  "solver": {"method": "dfsph"}, "output": {"fps": 300, "frames": 300}}"""
+
+
+@pytest.mark.parametrize("method", ["dfsph", "wcsph"])
+def test_pressure_within_a_column_carries_the_weight_above(tmp_path, method):
+    # A 2D column 0.3 m deep, 0.2 m wide, from a lattice at rest: at rest the pressure at height y carries the
+    # weight of the water above it, g m N(above y) / width, and a disc's mean pressure is its centre's where the
+    # pressure is linear in y. The column rings (its start holds no pressure; WCSPH's breathes by +-36%), so the
+    # check is on the mean over 1/3 to 1 s, every 1/300 s: measured 0.991 and 1.001 (DFSPH), 0.994 and 0.995
+    # (WCSPH) at 0.24 and 0.2 m deep. 3%: the ringing's unfinished cycles move such means by about 1% (at 30
+    # frames a second DFSPH's read 1.005 and 1.004, WCSPH's 1.03 over 1 s and 1.01 over 2 s). Seen failing
+    # without DFSPH's divergence solve's pressure (0.969).
+    scene = tmp_path / "column.json"
+    scene.write_text(COLUMN)
+    sim = surge.Simulation(str(scene), [f"solver.method={method}"], out=str(tmp_path / "run"))
+    mass = 1000 * 0.01 ** 2  # kg per metre of depth
+    ratios = []
+    while sim.step_frame():
+        if sim.time <= 1 / 3:
+            continue
+        y = sim.positions()[:, 1]
+        ratios.append([sim.pressure_within([0.1, h], 0.04) / (9.81 * mass * np.count_nonzero(y > h) / 0.2)
+                       for h in (0.06, 0.1)])
+    mean = np.mean(ratios, axis=0)
+    print(method, mean)
+    assert mean == pytest.approx([1, 1], abs=0.03)
+
+
+def test_pressure_within_leaves_the_run_as_it_was(tmp_path):
+    # Asking between frames changes no byte of the frames; PBF has no pressures; a centre of the wrong length is
+    # a ValueError.
+    sets = ["output.frames=3", "solver.method=wcsph"]
+    quiet = surge.Simulation(SCENE, sets, out=str(tmp_path / "quiet"))
+    asked = surge.Simulation(SCENE, sets, out=str(tmp_path / "asked"))
+    while quiet.step_frame():
+        asked.step_frame()
+        assert asked.pressure_within([0.5, 0.3], 0.1) > 0
+    assert frames(tmp_path / "quiet") == frames(tmp_path / "asked")
+    for name in frames(tmp_path / "quiet"):
+        assert (tmp_path / "quiet" / "particles" / name).read_bytes() == \
+            (tmp_path / "asked" / "particles" / name).read_bytes(), name
+    pbf = surge.Simulation(SCENE, ["output.frames=1"], out=str(tmp_path / "pbf"))
+    assert np.isnan(pbf.pressure_within([0.5, 0.3], 0.1))
+    with pytest.raises(ValueError, match="centre"):
+        asked.pressure_within([0.5, 0.3, 0.0], 0.1)
