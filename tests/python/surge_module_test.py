@@ -105,9 +105,9 @@ def test_pressure_within_a_column_carries_the_weight_above(tmp_path, method):
     # weight of the water above it, g m N(above y) / width, and a disc's mean pressure is its centre's where the
     # pressure is linear in y. The column rings (its start holds no pressure; WCSPH's breathes by +-36%), so the
     # check is on the mean over 1/3 to 1 s, every 1/300 s: measured 0.991 and 1.001 (DFSPH), 0.994 and 0.995
-    # (WCSPH) at 0.24 and 0.2 m deep. 3%: the ringing's unfinished cycles move such means by about 1% (at 30
-    # frames a second DFSPH's read 1.005 and 1.004, WCSPH's 1.03 over 1 s and 1.01 over 2 s). Seen failing
-    # without DFSPH's divergence solve's pressure (0.969).
+    # (WCSPH) at 0.24 and 0.2 m deep. 3%: the ringing's unfinished cycles move such means by about 1% (sampled
+    # 30 times a second against rho g times the depth below the top particle, DFSPH's read 1.005 and 1.004,
+    # WCSPH's 1.03 over 1 s and 1.01 over 2 s). Seen failing without DFSPH's divergence solve's pressure (0.969).
     scene = tmp_path / "column.json"
     scene.write_text(COLUMN)
     sim = surge.Simulation(str(scene), [f"solver.method={method}"], out=str(tmp_path / "run"))
