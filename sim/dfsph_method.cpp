@@ -36,7 +36,7 @@ void dfsphDefaults(Scene& scene) {
 const FluidMethod kDfsphMethod = {"dfsph", "Divergence-Free SPH (Bender & Koschier 2015, 2017)",
     &makeMethod<DfsphSolver, 2>, &makeMethod<DfsphSolver, 3>, 360, 800,
     &dfsphPushesPerFrame, &dfsphDefaults, nullptr, &declareDfsphKeys,
-    "more solver.substeps or a smaller solver.max_density_error", true, "solver.max_iterations", nullptr, 4,
-    "124, 92, 19"};
+    "more solver.substeps or a smaller solver.max_density_error", true, "solver.max_iterations", nullptr, 3.75,
+    "128, 93, 18"};
 
 }  // namespace surge

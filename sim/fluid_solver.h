@@ -153,7 +153,8 @@ struct FluidMethod {
   const char* adhesionAngles = nullptr;
   // The kernel's support, in spacings, that solver.kernel_radius 0 gives a 2D scene with surface tension: at 2
   // spacings its cohesion holds a 2D drop as a crystal; the method's own width lets it round and ring at
-  // Rayleigh's frequency (docs/surface-tension.md, "The 2D support").
+  // Rayleigh's frequency, and DFSPH's and WCSPH's 3.75 is where the calibration's sum is the same on any
+  // arrangement of the particles (docs/surface-tension.md, "The 2D support", "The calibration's lattice").
   double surfaceTensionSupport2d = 2;
   // The same drop in 2D at that support, in degrees, for surge sim's note (docs/surface-tension.md, "Adhesion in
   // 2D"); null for none measured.

@@ -86,6 +86,6 @@ std::vector<std::string> wcsphNotes(const Scene& scene) {
 const FluidMethod kWcsphMethod = {"wcsph", "weakly compressible SPH (Monaghan 1994, Becker & Teschner 2007)",
     &makeMethod<WcsphSolver, 2>, &makeMethod<WcsphSolver, 3>, 250, 400,
     &wcsphPushesPerFrame, &resolveWcsphDefaults, &wcsphNotes, &declareWcsphKeys,
-    "a smaller solver.cfl or solver.time_step", false, nullptr, nullptr, 4, "122, 93, 44"};
+    "a smaller solver.cfl or solver.time_step", false, nullptr, nullptr, 3.75, "126, 94, 47"};
 
 }  // namespace surge
