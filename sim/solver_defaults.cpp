@@ -222,14 +222,14 @@ std::vector<std::string> solverNotes(const Scene& scene) {
   const bool adhesion = sceneHasAdhesion(scene) && sceneSurfaceTension(scene) > 0;
   std::string name = method.name;
   std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::toupper(c)); });
-  // In 3D the adhesion's calibration is measured at 2 and 2.5 spacings of support (adhesionCalibration).
+  // In 3D the adhesion's calibration is measured at 2, 2.5 and 3 spacings of support (adhesionCalibration).
   if (adhesion && scene.dimensions == 3 && adhesionCalibration(3, support) == 0) {
     notes.push_back(
-        "adhesion is calibrated at 2 and 2.5 spacings of kernel support (a drop on a plate at 116, 88, 64 "
-        "and 117, 93, 61 degrees at adhesion 0.25, 0.5, 0.75, Young's 120, 90, 60); with " +
+        "adhesion is calibrated at 2, 2.5 and 3 spacings of kernel support (a drop on a plate at 116, 88, 64, "
+        "117, 93, 61 and 120, 91, 53 degrees at adhesion 0.25, 0.5, 0.75, Young's 120, 90, 60); with " +
         threeFigures(support) +
         " spacings it may not give Young's angle: measured, 2.25 wets more (113 and 76 degrees at 0.25 and "
-        "0.5, a film at 0.75) and 3 less (118, 101, 84) (docs/surface-tension.md)");
+        "0.5, a film at 0.75) (docs/surface-tension.md)");
   }
   // It meets Young's angle in DFSPH and WCSPH; where a method's does not, its registration gives the angles it reads at
   // the 3D default support (FluidMethod::adhesionAngles).
