@@ -761,8 +761,8 @@ TEST(SurfaceTension, SurgeSimSaysA3DDropAtTwoSpacingsKeepsASet) {
   }
 }
 
-// The adhesion's calibration is measured at 2 and 2.5 spacings of support (the test above; adhesionCalibration),
-// not at 2.25 or 3: surge sim says so where a scene with adhesion and surface tension has another support.
+// The adhesion's calibration is measured at 2, 2.5 and 3 spacings of support (the test above; adhesionCalibration),
+// not at 2.25 or 3.5: surge sim says so where a scene with adhesion and surface tension has another support.
 TEST(SurfaceTension, SurgeSimSaysTheAdhesionIsCalibratedAtTwoTwoAndAHalfAndThreeSpacings) {
   auto adhesionNotes = [](const std::vector<std::string>& extra) {
     std::string json = R"({"name": "plate", "dimensions": 3, "domain": {"min": [-0.02, -0.006, -0.02],
