@@ -30,12 +30,17 @@ inline const std::vector<std::string>& tankFaceNames() {
 struct SolverSettings {
   std::string method = "pbf";
   int substeps = 0;  // 0 in the file: max(4, stableSubsteps) (resolved)
-  int iterations = 0;        // PBF; 0 in the file: 4, or 30 where the fluids' densities differ (resolved on load)
+  // PBF; 0 in the file: 4, 8 where surface tension holds a fluid under gravity, or 30 where the fluids' densities
+  // differ (resolved on load)
+  int iterations = 0;
   double kernel_radius = 0;  // 0 in the file: 2 x particle_spacing, wider with surface tension (resolved on load)
   double rest_density = 1000;
   double relaxation_epsilon = 0.01;
   double warm_start = 0;  // PBF: share of last step's lambda sums applied before the iterations (experimental)
-  double chebyshev_rho = 0.85;  // PBF to max_density_error: the spectral radius its Chebyshev acceleration assumes
+  // PBF to max_density_error: the spectral radius its Chebyshev acceleration assumes. Left out (NaN): 0.85, or 0
+  // in 3D at a support wider than 2 spacings (resolved on load).
+  double chebyshev_rho = std::numeric_limits<double>::quiet_NaN();
+  static constexpr double kChebyshevRho = 0.85;
   // The smallest `iterations` cap the acceleration runs under: cut shorter, it stirs the fluid (sim/pbf_solver.cpp).
   static constexpr int kChebyshevLeastIterations = 8;
   double max_density_error = 0;  // > 0: iterate until the average density error is under it (DFSPH: 0 means 0.0005)

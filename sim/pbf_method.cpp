@@ -18,7 +18,8 @@ void declarePbfKeys(SceneVisitor& v, SolverSettings& s) {
   using field::atLeast, field::info, field::positive;
   v.integer("iterations", s.iterations,
             atLeast(0,
-                    "PBF: Jacobi iterations per step; 0: 4, or where the fluids' densities differ at most 30, to "
+                    "PBF: Jacobi iterations per step; 0: 4, 8 where surface tension holds a fluid under gravity "
+                    "(docs/surface-tension.md), or where the fluids' densities differ at most 30, to "
                     "max_density_error (0.001 if 0; docs/several-fluids.md)",
                     "", 10000));
   v.real("relaxation_epsilon", s.relaxation_epsilon,
@@ -30,10 +31,13 @@ void declarePbfKeys(SceneVisitor& v, SolverSettings& s) {
                     "kinetic energy to a deep 2D dam break (docs/speed-accuracy.md); 0 turns it off", "", 0.9));
   static_assert(SolverSettings::kChebyshevLeastIterations == 8, "chebyshev_rho's description names the cap");
   v.real("chebyshev_rho", s.chebyshev_rho,
-         atLeast(0, "PBF, when iterating to max_density_error with iterations >= 8: the Jacobi iterations' "
-                    "spectral radius that their Chebyshev acceleration assumes (Wang 2015); the larger, the "
-                    "fewer iterations for the same density error, up to where it overshoots (0.95 blows a dam "
-                    "break up; docs/speed-accuracy.md); 0 turns it off", "", 0.95));
+         atLeast(0,
+                 "PBF, when iterating to max_density_error with iterations >= 8: the Jacobi iterations' "
+                 "spectral radius that their Chebyshev acceleration assumes (Wang 2015); the larger, the "
+                 "fewer iterations for the same density error, up to where it overshoots (0.95 blows a dam "
+                 "break up; docs/speed-accuracy.md); 0 turns it off; left out: 0.85, or 0 in 3D at a kernel "
+                 "support wider than 2 spacings (a pool there blows up at 0.85)",
+                 "", 0.95));
   v.real("scorr_k", s.scorr_k,
          atLeast(0,
                  "PBF eq. 13 artificial pressure k, in units of the rest lattice's lambda; 0 turns s_corr off (as "
@@ -54,15 +58,30 @@ bool scorrOffByDefault(const Scene& scene) {
   return scene.densitiesDiffer() && sceneSurfaceTension(scene) == 0;
 }
 
+// Where surface tension holds a fluid under gravity: its wider support's 4 iterations leave a standing fluid
+// compressed, and a pool 40 particles deep blows up within its first frame; 8 hold it (docs/surface-tension.md, "A
+// pool under gravity"). Iterated to an average density error instead, a drop into a thin layer stops on the energy
+// check: the layer at rest meets the error with no iteration, and the impact goes uncorrected.
+bool standingWithSurfaceTension(const Scene& scene) {
+  return sceneSurfaceTension(scene) > 0 && scene.gravity.squaredNorm() > 0;
+}
+
 // Where the fluids' densities differ PBF iterates to a density error of 0.1% (at most 30 iterations), and without
 // surface tension leaves s_corr off, unless the file says otherwise: under 4 fixed iterations a heavy column sags
 // for 0.05 s before its pressure holds it, and s_corr's push, a step's, holds the converged interior against the
 // flow. Rayleigh-Taylor's growth read 0.60 to 0.84 of theory at 4 to 32 steps a frame with them, 0.86 to 0.95
 // without. A drop held by surface tension keeps s_corr: converged without it, oil in water stays 2.4 to 3.1% off
-// round where it rounds to 1.4 to 1.8% with it (docs/several-fluids.md).
+// round where it rounds to 1.4 to 1.8% with it (docs/several-fluids.md). Chebyshev's acceleration, measured at 2
+// spacings, overshoots at 3D's wider support with surface tension: a pool 20 particles deep there gains energy within
+// a frame at 0.85 and settles at 0. A fluid surface tension holds under gravity takes 8 iterations.
 void resolvePbfDefaults(Scene& scene) {
-  if (!scene.densitiesDiffer()) return;
   SolverSettings& s = scene.solver;
+  if (std::isnan(s.chebyshev_rho) && scene.dimensions == 3 && s.kernel_radius > 2 * scene.particle_spacing * (1 + 1e-9))
+    s.chebyshev_rho = 0;
+  if (!scene.densitiesDiffer()) {
+    if (s.iterations == 0 && standingWithSurfaceTension(scene)) s.iterations = 8;
+    return;
+  }
   if (s.iterations == 0) {
     s.iterations = 30;
     if (s.max_density_error == 0) s.max_density_error = 0.001;
@@ -93,6 +112,11 @@ std::vector<std::string> pbfNotes(const Scene& scene) {
                     " fixed where the fluids' densities differ: a heavy column sags under fixed iterations before its "
                     "pressure holds it (a Rayleigh-Taylor mode grows at 0.75 of theory at 4); left out, PBF "
                     "iterates to a density error of 0.1%, at most 30 times a step");
+  else if (standingWithSurfaceTension(scene) && scene.solver.iterations < 8 && scene.solver.max_density_error == 0)
+    notes.push_back("solver.iterations " + std::to_string(scene.solver.iterations) +
+                    " where surface tension holds a fluid under gravity: at its wider kernel support a standing "
+                    "fluid stays compressed under them (a 2D pool 40 particles deep blows up within its first frame "
+                    "at 4); left out, PBF takes 8 in such a scene");
   if (scorrOffByDefault(scene) && scene.solver.scorr_k > 0)
     notes.push_back("solver.scorr_k where the fluids' densities differ: s_corr's push, a step's, holds the interior "
                     "against the flow (a Rayleigh-Taylor mode grows at 0.60 of theory at 32 steps a frame); left out, "

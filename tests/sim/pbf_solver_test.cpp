@@ -298,7 +298,7 @@ FrontRun collapseSquareColumn(double warmStart, double chebyshevRho) {
 // within 0.21 a without the warm start and 0.19 a with it; 56 and 38 iterations a step. With the sums not
 // reordered with the particles, the warm-started front leaves the band.
 TEST(PbfSolver, DamBreakFrontFollowsMartinAndMoyceWithFewerIterationsAccelerated) {
-  const double rho = SolverSettings().chebyshev_rho;  // the default
+  const double rho = SolverSettings::kChebyshevRho;  // the default
   const FrontRun plain = collapseSquareColumn(0, 0), chebyshev = collapseSquareColumn(0, rho),
                  warm = collapseSquareColumn(0.5, rho);
   const std::pair<const char*, const FrontRun*> runs[] = {{"plain", &plain}, {"chebyshev", &chebyshev}, {"warm", &warm}};
