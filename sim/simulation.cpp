@@ -316,9 +316,11 @@ class FrameLoop final : public SimulationRun {
       record_.removed = sources_->removed;
       ledger.add(sources_->work);
     }
-    // Surface tension's work is surface energy released: credited up to the most the fluid's surface held.
+    // Surface tension's work is surface energy released: credited from none up to the most the fluid's surface
+    // held. Below none it is not surface stored but a drift: a WCSPH pool at rest with surface tension sums -8e-4
+    // J/m a frame (docs/surface-tension.md, "A pool under gravity").
     forceWork_ += solver.takeForceWork();
-    const double credit = std::min(forceWork_, surfaceEnergy_) - forceCredited_;
+    const double credit = std::clamp(forceWork_, 0.0, surfaceEnergy_) - forceCredited_;
     ledger.add(credit);
     forceCredited_ += credit;
     record_.phases = solver.phaseTimes();
