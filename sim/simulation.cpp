@@ -317,8 +317,8 @@ class FrameLoop final : public SimulationRun {
       ledger.add(sources_->work);
     }
     // Surface tension's work is surface energy released: credited from none up to the most the fluid's surface
-    // held. Below none it is not surface stored but a drift: a WCSPH pool at rest with surface tension sums -8e-4
-    // J/m a frame (docs/surface-tension.md, "A pool under gravity").
+    // held. Below none it is credited none: a WCSPH pool at rest sums -8e-4 J/m a frame with no surface stored
+    // (docs/surface-tension.md, "A pool under gravity"); a splash that does store some is checked the more loosely.
     forceWork_ += solver.takeForceWork();
     const double credit = std::clamp(forceWork_, 0.0, surfaceEnergy_) - forceCredited_;
     ledger.add(credit);
