@@ -69,8 +69,8 @@ TEST(SurfaceTensionUnderGravity, APoolStandsAtRestInPbfAtItsDefaults) {
 }
 
 // A shallow pool, 10 particles deep and 50 across, in WCSPH: at rest (RMS speed 1.3 mm/s at the end, held under 1
-// cm/s), its surface tension's work drifts below none (-5e-5 J/m a frame, about sigma times the hydrostatic
-// pressure's reach), which the energy account once took as surface energy stored and stopped the run at frame 16.
+// cm/s), its surface tension's work drifts below none (-6e-5 J/m a frame from frame 5; its cause is not found),
+// which the energy account once took as surface energy stored and stopped the run at frame 16.
 // The account credits it from none (sim/simulation.cpp), so the run reaches its end with source_work at none.
 TEST(SurfaceTensionUnderGravity, AShallowPoolStandsAtRestInWcsphAndItsAccountHoldsIt) {
   Scene scene = parseScene(R"({"name": "shallow", "dimensions": 2, "particle_spacing": 0.001,
