@@ -35,7 +35,10 @@ struct SolverSettings {
   int iterations = 0;
   double kernel_radius = 0;  // 0 in the file: 2 x particle_spacing, wider with surface tension (resolved on load)
   double rest_density = 1000;
-  double relaxation_epsilon = 0.01;
+  // PBF eq. 11's epsilon. Left out (NaN): 0.01, or 0.8 in 2D with surface tension at a support wider than 3
+  // spacings (resolved on load).
+  double relaxation_epsilon = std::numeric_limits<double>::quiet_NaN();
+  static constexpr double kRelaxationEpsilon = 0.01;
   double warm_start = 0;  // PBF: share of last step's lambda sums applied before the iterations (experimental)
   // PBF to max_density_error: the spectral radius its Chebyshev acceleration assumes. Left out (NaN): 0.85, or 0
   // in 3D at a support wider than 2 spacings (resolved on load).

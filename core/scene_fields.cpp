@@ -285,7 +285,7 @@ void visitScene(Scene& s, SceneVisitor& v) {
     v.real("kernel_radius", s.solver.kernel_radius,
            atLeast(0,
                    "SPH kernel radius h; 0 means 2 x particle_spacing, and with surface tension 2.5 spacings "
-                   "in 3D and in 2D the method's own support, 4 spacings in DFSPH and WCSPH, 2.5 in PBF "
+                   "in 3D and in 2D the method's own support, 3.75 spacings in DFSPH and WCSPH, 3.5 in PBF "
                    "(docs/surface-tension.md)",
                    "m"));
     v.real("rest_density", s.solver.rest_density, positive("rest density rho_0", "kg/m^3"));

@@ -350,8 +350,9 @@ void validateScene(Scene& s, const std::string& where) {
   if (solverDefaults()) solverDefaults()(s);
   // The methods' keys where their own defaults (PBF where the fluids' densities differ, WCSPH with surface tension
   // in 3D) left them unset, and in every other scene, whose scene.json writes them too: 4 iterations, s_corr 0.1,
-  // Chebyshev 0.85, alpha 0.05.
+  // Chebyshev 0.85, relaxation 0.01, alpha 0.05.
   if (s.solver.iterations == 0) s.solver.iterations = 4;
+  if (std::isnan(s.solver.relaxation_epsilon)) s.solver.relaxation_epsilon = SolverSettings::kRelaxationEpsilon;
   if (std::isnan(s.solver.scorr_k)) s.solver.scorr_k = 0.1;
   if (std::isnan(s.solver.chebyshev_rho)) s.solver.chebyshev_rho = SolverSettings::kChebyshevRho;
   if (std::isnan(s.solver.artificial_viscosity)) s.solver.artificial_viscosity = 0.05;

@@ -159,6 +159,9 @@ struct FluidMethod {
   // The same drop in 2D at that support, in degrees, for surge sim's note (docs/surface-tension.md, "Adhesion in
   // 2D"); null for none measured.
   const char* adhesionAngles2d = nullptr;
+  // The narrowest 2D support, in spacings, at which its cohesion lets a drop round: below it the lattice holds as a
+  // crystal, and surge sim says so (DFSPH's is one at 2.5; PBF's, under Wendland's kernels, rounds there).
+  double roundingSupport2d = 2.75;
 };
 
 // FluidMethod::make2 and make3 for a solver class template.

@@ -23,8 +23,11 @@ void declarePbfKeys(SceneVisitor& v, SolverSettings& s) {
                     "max_density_error (0.001 if 0; docs/several-fluids.md)",
                     "", 10000));
   v.real("relaxation_epsilon", s.relaxation_epsilon,
-         atLeast(0, "PBF eq. 11 relaxation epsilon, as a fraction of the rest lattice's sum of squared "
-                    "constraint gradients (0.01 softens the constraint by 1%)"));
+         atLeast(0,
+                 "PBF eq. 11 relaxation epsilon, as a fraction of the rest lattice's sum of squared "
+                 "constraint gradients (0.01 softens the constraint by 1%); left out: 0.01, or 0.8 in 2D with "
+                 "surface tension at a kernel support wider than 3 spacings (its default 3.5: a wider 2D lattice's "
+                 "Jacobi iterations overshoot; docs/surface-tension.md)"));
   v.real("warm_start", s.warm_start,
          atLeast(0, "PBF, experimental: the share of the last step's lambda sums applied as one correction "
                     "before the Jacobi iterations (a warm start, as DFSPH's); fewer iterations, but it adds "
@@ -42,7 +45,8 @@ void declarePbfKeys(SceneVisitor& v, SolverSettings& s) {
          atLeast(0,
                  "PBF eq. 13 artificial pressure k, in units of the rest lattice's lambda; 0 turns s_corr off (as "
                  "a domain periodic along every axis does: no spray or sheets there); left out: 0.1, or 0 where "
-                 "the fluids' densities differ and none has surface tension"));
+                 "the fluids' densities differ and none has surface tension, and in 2D with surface tension at a "
+                 "kernel support wider than 3 spacings (its push damps a drop's ringing)"));
   v.integer("scorr_n", s.scorr_n, atLeast(1, "PBF eq. 13 exponent n", "", 16));
   {
     FieldInfo dq = positive("PBF eq. 13 delta q, as a fraction of the kernel radius (paper: 0.1 to 0.3)");
@@ -66,6 +70,16 @@ bool standingWithSurfaceTension(const Scene& scene) {
   return sceneSurfaceTension(scene) > 0 && scene.gravity.squaredNorm() > 0;
 }
 
+// A 2D scene with surface tension at a support wider than 3 spacings (PBF's own there is 3.5): its drop rings at
+// Rayleigh's frequency swing after swing, where at 2.5 the lattice yields in bursts and its later swings run 5 to
+// 16% slow. Its Jacobi iterations overshoot there (the rest lattice's largest eigenvalue 4.40 against 2.47 at 2.5):
+// relaxation 0.8 holds a 40 x 40 square; s_corr's push, a step's, damps the ringing (docs/surface-tension.md, "PBF
+// 2D at 3.5 spacings").
+bool wide2dWithSurfaceTension(const Scene& scene) {
+  return scene.dimensions == 2 && sceneSurfaceTension(scene) > 0 &&
+         scene.solver.kernel_radius > 3 * scene.particle_spacing * (1 + 1e-9);
+}
+
 // Where the fluids' densities differ PBF iterates to a density error of 0.1% (at most 30 iterations), and without
 // surface tension leaves s_corr off, unless the file says otherwise: under 4 fixed iterations a heavy column sags
 // for 0.05 s before its pressure holds it, and s_corr's push, a step's, holds the converged interior against the
@@ -78,6 +92,10 @@ void resolvePbfDefaults(Scene& scene) {
   SolverSettings& s = scene.solver;
   if (std::isnan(s.chebyshev_rho) && scene.dimensions == 3 && s.kernel_radius > 2 * scene.particle_spacing * (1 + 1e-9))
     s.chebyshev_rho = 0;
+  if (wide2dWithSurfaceTension(scene)) {
+    if (std::isnan(s.relaxation_epsilon)) s.relaxation_epsilon = 0.8;
+    if (std::isnan(s.scorr_k)) s.scorr_k = 0;
+  }
   if (!scene.densitiesDiffer()) {
     if (s.iterations == 0 && standingWithSurfaceTension(scene)) s.iterations = 8;
     return;
@@ -100,9 +118,10 @@ std::vector<std::string> pbfNotes(const Scene& scene) {
                     std::to_string(stable) +
                     " a PBF pool this deep needs to stay at rest (dt <= 0.9 particle_spacing / sqrt(g depth)): its "
                     "steps will be shortened to them while the fluid stands that deep");
-  // PBF's own kernels (poly6, spiky) wider than 2.5 spacings stir a fluid at rest (docs/speed-accuracy.md).
+  // PBF's own kernels (poly6, spiky) wider than 2.5 spacings stir a fluid at rest (docs/speed-accuracy.md); a 2D
+  // scene with surface tension takes Wendland's (pbfUsesWendland).
   const double spacings = scene.solver.kernel_radius / scene.particle_spacing;
-  if (spacings > 2.5 + 1e-9)
+  if (spacings > 2.5 + 1e-9 && !pbfUsesWendland(scene))
     notes.push_back("solver.kernel_radius is " + formatNumber(spacings) + " spacings: PBF's kernels wider than 2.5 "
                     "spacings stir a fluid at rest (a 2D pool at 3 keeps six times the kinetic energy it keeps at 2; "
                     "at 3.5 it gains energy until the energy check stops it)");
@@ -134,10 +153,12 @@ std::vector<std::string> pbfNotes(const Scene& scene) {
 // 400 bytes a particle in 3D: about 340 of channels (x, v, x* and a scratch copy, ids, lambdas, the grid's) and
 // 30 neighbours with their gradient factors, the frame being written, and the allocator's slack; 250 in 2D
 // (docs/performance.md).
+// clang-format off
 const FluidMethod kPbfMethod = {"pbf", "Position Based Fluids (Macklin & Mueller 2013)",
     &makeMethod<PbfSolver, 2>, &makeMethod<PbfSolver, 3>, 250, 400,
     &pbfPushesPerFrame, &resolvePbfDefaults, &pbfNotes, &declarePbfKeys,
     "more solver.substeps or solver.iterations (at many steps a frame, a smaller solver.scorr_k: its push is a step's)",
-    true, "solver.iterations", "116, 96, 76", 2.5, "117, 90, 62"};
+    true, "solver.iterations", "116, 96, 76", 3.5, "116, 81, 20", 2.5};
+// clang-format on
 
 }  // namespace surge

@@ -26,11 +26,6 @@ inline float integerPower(float x, int n) {
 // may differ in the last bits), never on the thread count. A pair closer than coincidentLength_ (see
 // coincidentOffset) is rare; its particle is done again by the scalar loop beside.
 
-// Wendland C2 for eq. 2 and 8 in a 2D scene with surface tension (PbfWendlandC2); poly6 and spiky elsewhere.
-bool pbfUsesWendland(const Scene& scene) {
-  return scene.dimensions == 2 && sceneSurfaceTension(scene) > 0;
-}
-
 // The rest lattice through the density's kernel (eq. 2) and its gradient's (eq. 8).
 template <int Dim>
 RestLattice<Dim> pbfRestLattice(const Scene& scene) {
@@ -44,6 +39,10 @@ RestLattice<Dim> pbfRestLattice(const Scene& scene) {
 }
 
 }  // namespace
+
+bool pbfUsesWendland(const Scene& scene) {
+  return scene.dimensions == 2 && sceneSurfaceTension(scene) > 0;
+}
 
 // The mass makes an interior particle of the rest lattice have exactly rho_0 (eq. 2 summed over the lattice),
 // so a block at rest starts unstressed and keeps its volume N x spacing^d.

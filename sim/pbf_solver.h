@@ -35,6 +35,9 @@
 
 namespace surge {
 
+// Wendland C2 for eq. 2 and 8 in a 2D scene with surface tension (PbfWendlandC2); poly6 and spiky elsewhere.
+bool pbfUsesWendland(const Scene& scene);
+
 template <int Dim>
 class PbfSolver final : public ParticleSolver<Dim> {
  public:

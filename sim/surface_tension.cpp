@@ -61,7 +61,10 @@ bool sceneHasAdhesion(const Scene& scene) {
 }
 
 double adhesionCalibration(int dimensions, double spacings) {
-  if (dimensions == 2) return std::abs(spacings - 3.75) < 0.05 ? 0.9 : 0;
+  if (dimensions == 2) {
+    if (std::abs(spacings - 3.5) < 0.05) return 1.15;
+    return std::abs(spacings - 3.75) < 0.05 ? 0.9 : 0;
+  }
   if (std::abs(spacings - 2) < 0.05) return 1;
   if (std::abs(spacings - 2.5) < 0.05) return 0.75;
   if (std::abs(spacings - 3) < 0.05) return 0.9;

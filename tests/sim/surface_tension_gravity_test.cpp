@@ -40,10 +40,14 @@ Scene poolScene(int dim, bool oil, const std::vector<std::string>& sets = {}) {
 
 // The pool runs to its last frame (the energy check stops a run that gains energy), holds its density within 2% (a
 // pool compressed by e stands lower by about e of its potential energy, and the energy account allows 2% of the
-// most energy the fluid held), and settles: its motion at the end is below its first frame's (the lattice settling
-// under its weight, and its meniscus), where a pool that boils gains it. Measured: 2D 1.34%, kinetic energy 0.46 of
-// frame 1's at 1 s; 3D 0.20%, 0.58 at 0.33 s; 3D with oil (iterated to 0.1%) 0.09%, 0.32. At 4 iterations the 2D
-// and 3D pools blew up in their first frame (2.5 spacings of support; 2D under Wendland's kernels), and with oil,
+// most energy the fluid held), and gains no energy after its first frame: its kinetic and potential energy, less
+// the work surface tension did, is at the end no more than at frame 1. In 3D it also settles: its motion at the end
+// is below its first frame's (the lattice settling under its weight, and its meniscus), where a pool that boils
+// gains it. The 2D pool at PBF's 3.5 spacings passes its settling's energy into a slosh (its kinetic energy peaks at
+// 1.8 times frame 1's at 1.3 s and is back at 1.0 by 4 s), so there the energy, not the motion, is held. Measured:
+// 2D 0.90%, energy 0.754591 J/m against 0.761903 at frame 1 (at 2.5 spacings with s_corr, before session 71: 1.34%,
+// motion 0.46 of frame 1's); 3D 0.20%, 0.58 at 0.33 s; 3D with oil (iterated to 0.1%) 0.09%, 0.32. At 4 iterations
+// the 2D and 3D pools blew up in their first frame (2D at 2.5 spacings under Wendland's kernels), and with oil,
 // under Chebyshev's 0.85, the 3D pool gained energy within it: the energy check stopped each. Without surface
 // tension PBF's 4 iterations at 2 spacings hold the 2D pool to 4.6%.
 TEST(SurfaceTensionUnderGravity, APoolStandsAtRestInPbfAtItsDefaults) {
@@ -60,11 +64,17 @@ TEST(SurfaceTensionUnderGravity, APoolStandsAtRestInPbfAtItsDefaults) {
     const auto stats = readStats(dir);
     const auto& kinetic = stats.at("kinetic_energy");
     ASSERT_EQ(kinetic.size(), size_t(scene.output.frames + 1));
+    const auto energy = [&](size_t frame) {
+      return kinetic.at(frame) + stats.at("potential_energy").at(frame) - stats.at("source_work").at(frame);
+    };
     const double error = stats.at("density_error_avg").back(), settled = kinetic.back() / kinetic.at(1);
-    std::printf("%dD pool%s: density error %.4f, kinetic energy at the end %.3g of frame 1's\n", dim,
-                oil ? " with oil" : "", error, settled);
+    std::printf(
+        "%dD pool%s: density error %.4f, kinetic energy at the end %.3g of frame 1's, energy %.6g at "
+        "frame 1, %.6g at the end\n",
+        dim, oil ? " with oil" : "", error, settled, energy(1), energy(kinetic.size() - 1));
     EXPECT_LT(error, 0.02);
-    EXPECT_LT(settled, 1.0);
+    EXPECT_LE(energy(kinetic.size() - 1), energy(1));
+    if (dim == 3) EXPECT_LT(settled, 1.0);
   }
 }
 

@@ -227,21 +227,14 @@ TEST(SurfaceTension, ALarger2DDropOscillatesAtRayleighsFrequencyInWcsphAtItsDefa
 }
 
 // PBF in 2D with surface tension takes Wendland C2 for its density and its constraint's gradient (PbfWendlandC2), at
-// its 2.5 spacings: its drop first comes back through its rest shape after Rayleigh's half period, within the
-// issue's 10%, and rings on. Measured 1.004 (0.97 to 1.00 at 5% to 20% kicks, R = 10 and 16 mm, steps of 0.94 to
-// 1.37 ms). Its later half periods are not held to the bound: they spread from 0.93 to 1.18 of Rayleigh's with the
-// step and the kick, a last bit of arithmetic moving them (docs/surface-tension.md, "PBF's 2D kernel"). With the
-// paper's poly6 and spiky it came back at 0.76 and rang 1.6 times as fast (the test fails there).
-TEST(SurfaceTension, A2DDropFirstSwingsAtRayleighsFrequencyInPbfAtItsDefaults) {
-  const double radius = 0.01, omega = std::sqrt(6 * kSigma / (kRho * std::pow(radius, 3)));
-  auto solver = makeFluidSolver<2>(dropScene(2, "pbf", radius));
-  relaxDrop<2>(*solver, radius, 0.2);
-  ASSERT_FALSE(::testing::Test::HasFatalFailure());
-  const double half = M_PI / omega;
-  const std::vector<double> crossings = oscillationCrossings<2>(*solver, 0.1 * omega, half / 80, 5.5 * half, 5);
-  for (double t : crossings) std::printf("pbf 2D: back through its rest shape at %.4f half periods\n", t / half);
-  ASSERT_GE(crossings.size(), 4u) << "the drop did not ring";
-  EXPECT_NEAR(crossings[0] / half, 1.0, 0.1);
+// its 3.5 spacings, with relaxation 0.8 and no s_corr (resolvePbfDefaults): its drop rings at Rayleigh's frequency
+// swing after swing, as the other methods' do. Measured 0.947 and 0.943 (12 runs by step and jittered start: first
+// 0.91 to 1.00, next four 0.92 to 1.02). At 2.5 spacings with s_corr, the default before session 71, the first swing
+// held (1.004) but the lattice yielded in bursts after it and the later half periods ran 3 to 27% slow (the test
+// fails there: docs/surface-tension.md, "PBF 2D at 3.5 spacings"); with the paper's poly6 and spiky it came back at
+// 0.76.
+TEST(SurfaceTension, A2DDropOscillatesAtRayleighsFrequencyInPbfAtItsDefaults) {
+  expectRayleighsFrequency<2>("pbf", {});
 }
 
 // Laplace: a drop at rest holds a pressure (d - 1) sigma / R above the air's. The solver's own pressure holds the
@@ -480,9 +473,9 @@ Scene rectangleDropScene(const std::string& method, const std::vector<std::strin
 }
 
 // In 2D the 2% holds at the default support, which a 2D scene with surface tension gives 3.75 spacings in
-// DFSPH and WCSPH and 2.5 in PBF (FluidMethod::surfaceTensionSupport2d), in every method for a viscous drop (nu =
-// 2e-4 m^2/s) at 1, 1.5 and 2 s. Measured DFSPH 0.58, 0.31, 0.87%; WCSPH 1.01, 0.28, 0.45%; PBF 1.14, 1.31, 1.67% (its
-// Wendland C2 kernels; 1.00, 0.54, 0.41% with poly6 and spiky). At 2
+// DFSPH and WCSPH and 3.5 in PBF (FluidMethod::surfaceTensionSupport2d), in every method for a viscous drop (nu =
+// 2e-4 m^2/s) at 1, 1.5 and 2 s. Measured DFSPH 0.58, 0.31, 0.87%; WCSPH 1.01, 0.28, 0.45%; PBF 1.41, 1.69, 1.30% (its
+// Wendland C2 kernels at 3.5 spacings; 1.14, 1.31, 1.67% at 2.5; 1.00, 0.54, 0.41% with poly6 and spiky). At 2
 // spacings the square lattice re-packs into a hexagonal crystal that holds the rectangle's shape (DFSPH 0.56, WCSPH
 // 0.53, PBF 0.27) and the test fails (docs/surface-tension.md, "The 2D support").
 TEST(SurfaceTension, AViscousRectangleRoundsToWithinTwoPercentIn2DAtItsDefaults) {
@@ -531,8 +524,9 @@ TEST(SurfaceTension, SameBytesAtAnyThreadCountAndAfterAResume) {
 // sigma_1 + sigma_2 (sim/surface_tension.h). A 2:1 rectangle of oil (rho 900, sigma 0.03, 30 x 15 particles)
 // inside water (sigma 0.0728) in zero gravity starts at anisotropy 0.60 and rounds in every method to the issue's
 // 2% (by 1 s in WCSPH, 2 s in the others), at the default support of a 2D scene with surface tension
-// (FluidMethod::surfaceTensionSupport2d). Measured: DFSPH 0.154 at 1 s, 0.014 at 2 s; PBF 0.026 and 0.011 (at its
-// defaults where the densities differ: converged, s_corr kept with surface tension; 0.024 and 0.031 without s_corr);
+// (FluidMethod::surfaceTensionSupport2d). Measured: DFSPH 0.154 at 1 s, 0.014 at 2 s; PBF 0.143 and 0.014 (at its
+// defaults where the densities differ, converged, and at its 3.5 spacings without s_corr; at 2.5, before session 71,
+// 0.026 and 0.011 with s_corr, 0.024 and 0.031 without);
 // WCSPH 0.019 at 1 s (at 4 spacings, before session 68: DFSPH 0.238 and 0.012, WCSPH 0.003). At 2 spacings each kept a
 // set (DFSPH 0.47, PBF 0.28, WCSPH 0.53 at 1 s: the crystal, docs/surface-tension.md). Without the sigmas the rectangle
 // keeps 0.601 to 1e-3. In DFSPH the run is the same bytes at 1 and 2 threads and after a resume.
@@ -662,16 +656,18 @@ fs::path squareOnAPlate(const std::string& method, double adhesion, const std::s
 // whole, before session 68: 119.7, 89.9, 64.5). A 12 mm water drop's inertia carries its contact line past 60
 // degrees at 0.75 and it pins there as a film (18 degrees; surge sim's 2D note); with 3D's share of beta at 2.5
 // spacings (0.75) the viscous drop read 133, 108, 84 at 4 spacings and the test failed (docs/surface-tension.md,
-// "Adhesion in 2D").
-TEST(SurfaceTension, A2DDropOnAPlateSettlesAtYoungsAngleInDfsph) {
-  for (double adhesion : {0.25, 0.5, 0.75}) {
-    SCOPED_TRACE("adhesion " + std::to_string(adhesion));
-    const double angle =
-        capAngle(readParticlePly(framePath(squareOnAPlate("dfsph", adhesion, "2e-4"), "particles", 90, "ply")));
-    ASSERT_FALSE(std::isnan(angle)) << "the drop left the plate";
-    std::printf("2D drop on a plate, adhesion %.2f: %.1f degrees\n", adhesion, angle);
-    EXPECT_NEAR(angle, std::acos(2 * adhesion - 1) * 180 / M_PI, 10);
-  }
+// "Adhesion in 2D"). PBF at its 3.5 spacings takes 1.15 of beta (the share at 3.5): measured 119.2, 87.1, 60.7; with
+// beta whole 121.7, 95.6, 72.2 (the test fails), with 1.25 of it 115.1, 83.4, 48.9.
+TEST(SurfaceTension, A2DDropOnAPlateSettlesAtYoungsAngleInDfsphAndPbf) {
+  for (const std::string method : {"dfsph", "pbf"})
+    for (double adhesion : {0.25, 0.5, 0.75}) {
+      SCOPED_TRACE(method + ", adhesion " + std::to_string(adhesion));
+      const double angle =
+          capAngle(readParticlePly(framePath(squareOnAPlate(method, adhesion, "2e-4"), "particles", 90, "ply")));
+      ASSERT_FALSE(std::isnan(angle)) << "the drop left the plate";
+      std::printf("%s 2D drop on a plate, adhesion %.2f: %.1f degrees\n", method.c_str(), adhesion, angle);
+      EXPECT_NEAR(angle, std::acos(2 * adhesion - 1) * 180 / M_PI, 10);
+    }
 }
 
 // WCSPH's walls take a particle's pressure once in a scene with surface tension (Akinci 2012), not mirrored: the
@@ -698,15 +694,26 @@ TEST(SurfaceTension, A2DWaterDropOnAPlateSettlesAtYoungsAngleInWcsph) {
 }
 
 // solver.kernel_radius 0 gives a scene with surface tension 2.5 spacings in 3D and the method's own support in 2D
-// (FluidMethod::surfaceTensionSupport2d: DFSPH and WCSPH 3.75 spacings, PBF 2.5), and any other scene 2 spacings; a
-// radius the file gives is kept.
+// (FluidMethod::surfaceTensionSupport2d: DFSPH and WCSPH 3.75 spacings, PBF 3.5), and any other scene 2 spacings; a
+// radius the file gives is kept. PBF in 2D with surface tension at a support wider than 3 spacings takes relaxation
+// 0.8 and no s_corr where the file leaves them out (resolvePbfDefaults), 0.01 and 0.1 elsewhere.
 TEST(SurfaceTension, TheDefaultSupportWithSurfaceTensionIsTwoAndAHalfIn3DAndTheMethodsIn2D) {
   const auto spacings = [](int dim, const std::string& method, const std::vector<std::string>& extra) {
     return dropScene(dim, method, 0.005, extra).solver.kernel_radius / kSpacing;
   };
   EXPECT_NEAR(spacings(2, "dfsph", {}), 3.75, 1e-9);
   EXPECT_NEAR(spacings(2, "wcsph", {}), 3.75, 1e-9);
-  EXPECT_NEAR(spacings(2, "pbf", {}), 2.5, 1e-9);
+  EXPECT_NEAR(spacings(2, "pbf", {}), 3.5, 1e-9);
+  const auto pbf = [](int dim, const std::vector<std::string>& extra) {
+    const SolverSettings s = dropScene(dim, "pbf", 0.005, extra).solver;
+    return std::pair{s.relaxation_epsilon, s.scorr_k};
+  };
+  EXPECT_EQ(pbf(2, {}), std::pair(0.8, 0.0));
+  EXPECT_EQ(pbf(2, {"solver.kernel_radius=0.003"}), std::pair(0.01, 0.1));
+  EXPECT_EQ(pbf(2, {"solver.kernel_radius=0.0025"}), std::pair(0.01, 0.1));
+  EXPECT_EQ(pbf(2, {"fluids[0].surface_tension=0"}), std::pair(0.01, 0.1));
+  EXPECT_EQ(pbf(3, {"solver.kernel_radius=0.0035"}), std::pair(0.01, 0.1));
+  EXPECT_EQ(pbf(2, {"solver.relaxation_epsilon=0.1", "solver.scorr_k=0.05"}), std::pair(0.1, 0.05));
   for (const std::string method : {"dfsph", "wcsph", "pbf"}) {
     EXPECT_NEAR(spacings(3, method, {}), 2.5, 1e-9) << method;
     EXPECT_NEAR(spacings(3, method, {"fluids[0].surface_tension=0"}), 2, 1e-9) << method;
@@ -717,13 +724,14 @@ TEST(SurfaceTension, TheDefaultSupportWithSurfaceTensionIsTwoAndAHalfIn3DAndTheM
 }
 
 // Cohesion over 2 spacings holds a 2D drop as a crystal: surge sim says so where the scene sets a support under
-// 2.75 spacings and under the method's own, and names the radius the default gives.
+// the one that rounds it (2.75 spacings; 2.5 in PBF, FluidMethod::roundingSupport2d) and under the method's own,
+// and names the radius the default gives.
 TEST(SurfaceTension, SurgeSimSaysA2DDropAtTwoSpacingsKeepsItsShape) {
   auto crystalNotes = [](int dim, const std::string& method, const std::vector<std::string>& extra) {
     int count = 0;
     for (const std::string& note : solverNotes(dropScene(dim, method, 0.005, extra)))
       if (note.find("crystal") != std::string::npos) {
-        EXPECT_NE(note.find(method == "pbf" ? "2.5 spacings (0.0025 here)" : "3.75 spacings (0.00375 here)"),
+        EXPECT_NE(note.find(method == "pbf" ? "3.5 spacings (0.0035 here)" : "3.75 spacings (0.00375 here)"),
                   std::string::npos)
             << note;
         ++count;
@@ -808,7 +816,7 @@ TEST(SurfaceTension, SurgeSimSaysTheAdhesionIsCalibratedInDfsph) {
 }
 
 // In 2D surge sim gives each method's own angles (FluidMethod::adhesionAngles2d, the 3D test's drop in 2D at the
-// method's 2D support: DFSPH 128, 93, 18; PBF 117, 90, 62; WCSPH 126, 94, 47 degrees) in place of the 3D notes,
+// method's 2D support: DFSPH 128, 93, 18; PBF 116, 81, 20; WCSPH 126, 94, 47 degrees) in place of the 3D notes,
 // and says where the scene's support is not the one they were measured at.
 TEST(SurfaceTension, SurgeSimGivesEachMethodsAdhesionAnglesIn2D) {
   auto adhesionNotes = [](const std::string& method, const std::vector<std::string>& extra) {
@@ -823,7 +831,7 @@ TEST(SurfaceTension, SurgeSimGivesEachMethodsAdhesionAnglesIn2D) {
   };
   const std::vector<std::pair<std::string, std::string>> angles = {
       {"dfsph", "DFSPH at its own 3.75 spacings of kernel support reads 128, 93, 18 degrees"},
-      {"pbf", "PBF at its own 2.5 spacings of kernel support reads 117, 90, 62 degrees"},
+      {"pbf", "PBF at its own 3.5 spacings of kernel support reads 116, 81, 20 degrees"},
       {"wcsph", "WCSPH at its own 3.75 spacings of kernel support reads 126, 94, 47 degrees"}};
   for (const auto& [method, text] : angles) {
     const auto own = adhesionNotes(method, {"colliders[0].adhesion=0.5"});
