@@ -39,8 +39,8 @@ bool sceneHasAdhesion(const Scene& scene);
 // The share of beta (from Young's work of adhesion) with which the drop on a plate meets Young's angle, at a
 // kernel support of `spacings` particle spacings: measured in 3D at 2 (1), 2.5 (0.75) and 3 (0.9), in 2D at 3.5
 // (1.15, PBF's 2D support, in PBF) and 3.75 (0.9, DFSPH's and WCSPH's, in DFSPH); 0 elsewhere, where beta is taken
-// whole and, in 3D, surge sim notes it
-// (docs/surface-tension.md, "The adhesion by support", "The calibration's lattice").
+// whole and, in 3D, surge sim notes it (docs/surface-tension.md, "The adhesion by support", "The calibration's
+// lattice", "PBF 2D at 3.5 spacings").
 double adhesionCalibration(int dimensions, double spacings);
 // The most energy surface tension can release into the fluid of `initial` (the scene's lattice at t = 0): sigma
 // times its surface, counted as the lattice cells' faces that have no fluid cell beside them (an upper bound on a
