@@ -62,6 +62,11 @@ bool scorrOffByDefault(const Scene& scene) {
   return scene.densitiesDiffer() && sceneSurfaceTension(scene) == 0;
 }
 
+// True where the kernel's support is wider than `spacings` particle spacings (a radius set to exactly that is not).
+bool supportWiderThan(const Scene& scene, double spacings) {
+  return scene.solver.kernel_radius > spacings * scene.particle_spacing * (1 + 1e-9);
+}
+
 // Where surface tension holds a fluid under gravity: its wider support's 4 iterations leave a standing fluid
 // compressed, and a pool 40 particles deep blows up within its first frame; 8 hold it (docs/surface-tension.md, "A
 // pool under gravity"). Iterated to an average density error instead, a drop into a thin layer stops on the energy
@@ -76,8 +81,7 @@ bool standingWithSurfaceTension(const Scene& scene) {
 // relaxation 0.8 holds a 40 x 40 square; s_corr's push, a step's, damps the ringing (docs/surface-tension.md, "PBF
 // 2D at 3.5 spacings").
 bool wide2dWithSurfaceTension(const Scene& scene) {
-  return scene.dimensions == 2 && sceneSurfaceTension(scene) > 0 &&
-         scene.solver.kernel_radius > 3 * scene.particle_spacing * (1 + 1e-9);
+  return scene.dimensions == 2 && sceneSurfaceTension(scene) > 0 && supportWiderThan(scene, 3);
 }
 
 // Where the fluids' densities differ PBF iterates to a density error of 0.1% (at most 30 iterations), and without
@@ -90,8 +94,7 @@ bool wide2dWithSurfaceTension(const Scene& scene) {
 // a frame at 0.85 and settles at 0. A fluid surface tension holds under gravity takes 8 iterations.
 void resolvePbfDefaults(Scene& scene) {
   SolverSettings& s = scene.solver;
-  if (std::isnan(s.chebyshev_rho) && scene.dimensions == 3 && s.kernel_radius > 2 * scene.particle_spacing * (1 + 1e-9))
-    s.chebyshev_rho = 0;
+  if (std::isnan(s.chebyshev_rho) && scene.dimensions == 3 && supportWiderThan(scene, 2)) s.chebyshev_rho = 0;
   if (wide2dWithSurfaceTension(scene)) {
     if (std::isnan(s.relaxation_epsilon)) s.relaxation_epsilon = 0.8;
     if (std::isnan(s.scorr_k)) s.scorr_k = 0;
@@ -121,7 +124,7 @@ std::vector<std::string> pbfNotes(const Scene& scene) {
   // PBF's own kernels (poly6, spiky) wider than 2.5 spacings stir a fluid at rest (docs/speed-accuracy.md); a 2D
   // scene with surface tension takes Wendland's (pbfUsesWendland).
   const double spacings = scene.solver.kernel_radius / scene.particle_spacing;
-  if (spacings > 2.5 + 1e-9 && !pbfUsesWendland(scene))
+  if (supportWiderThan(scene, 2.5) && !pbfUsesWendland(scene))
     notes.push_back("solver.kernel_radius is " + formatNumber(spacings) + " spacings: PBF's kernels wider than 2.5 "
                     "spacings stir a fluid at rest (a 2D pool at 3 keeps six times the kinetic energy it keeps at 2; "
                     "at 3.5 it gains energy until the energy check stops it)");

@@ -253,8 +253,8 @@ std::vector<std::string> solverNotes(const Scene& scene) {
   // Cohesion over 2 spacings of support holds the lattice: in 2D as a crystal, in 3D in a set; the default's
   // wider support (defaultKernelSupport) lets a drop round and ring (docs/surface-tension.md, "The 2D support",
   // "The 3D support"). In 2D a support from the method's roundingSupport2d up rounds a drop too.
-  const double rounds = scene.dimensions == 2 ? method.roundingSupport2d : 2.75;
-  if (sceneSurfaceTension(scene) > 0 && support < std::min(own, rounds) - 1e-9) {
+  const double rounds = scene.dimensions == 2 ? std::min(own, method.roundingSupport2d) : own;
+  if (sceneSurfaceTension(scene) > 0 && support < rounds - 1e-9) {
     const bool flat = scene.dimensions == 2;
     char text[400];
     std::snprintf(text, sizeof text,
